@@ -1,0 +1,149 @@
+//! Finite cones and truncated cones (frusta) about the z axis from z = 0 to z = height, with
+//! radius going linearly from `radius0` to `radius1`, optionally closed by disk caps. The
+//! scene places them with a transform.
+
+use super::{nearest_root, HitRecord, SurfaceGeometry};
+use crate::math::{gamma, solve_quadratic, Bounds3, Ray, Vec3};
+use std::f64::consts::PI;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cone {
+    pub radius0: f64,
+    pub radius1: f64,
+    pub height: f64,
+    pub capped: bool,
+}
+
+const SIDE: u32 = 0;
+const BOTTOM: u32 = 1;
+const TOP: u32 = 2;
+
+impl Cone {
+    pub fn bounds(&self) -> Bounds3 {
+        let r = self.radius0.max(self.radius1);
+        Bounds3::new(Vec3::new(-r, -r, 0.0), Vec3::new(r, r, self.height))
+    }
+
+    /// dr/dz along the side.
+    fn slope(&self) -> f64 {
+        (self.radius1 - self.radius0) / self.height
+    }
+
+    fn radius_at(&self, z: f64) -> f64 {
+        self.radius0 + self.slope() * z
+    }
+
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
+        let (o, d) = (ray.origin, ray.direction);
+        let k = self.slope();
+        // x² + y² = (r₀ + k·z)² along o + t·d.
+        let r_o = self.radius0 + k * o.z;
+        let a = d.x * d.x + d.y * d.y - k * k * d.z * d.z;
+        let b = 2.0 * (o.x * d.x + o.y * d.y - k * r_o * d.z);
+        let c = o.x * o.x + o.y * o.y - r_o * r_o;
+        let in_height = |t: f64| {
+            let z = o.z + t * d.z;
+            (0.0..=self.height).contains(&z)
+        };
+        let mut best: Option<HitRecord> = nearest_root(solve_quadratic(a, b, c), t_max, in_height)
+            .map(|t| HitRecord {
+                t,
+                u: 0.0,
+                v: 0.0,
+                part: SIDE,
+            });
+        if self.capped && d.z != 0.0 {
+            for (part, z, r) in [(BOTTOM, 0.0, self.radius0), (TOP, self.height, self.radius1)] {
+                let t = (z - o.z) / d.z;
+                let limit = best.map_or(t_max, |h| h.t);
+                if t > 0.0 && t < limit {
+                    let (x, y) = (o.x + t * d.x, o.y + t * d.y);
+                    if x * x + y * y <= r * r {
+                        best = Some(HitRecord {
+                            t,
+                            u: 0.0,
+                            v: 0.0,
+                            part,
+                        });
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    pub fn surface(&self, ray: &Ray, hit: &HitRecord) -> SurfaceGeometry {
+        let p = ray.at(hit.t);
+        if hit.part == SIDE {
+            // Re-project radially onto the side at this height.
+            let z = p.z.clamp(0.0, self.height);
+            let r = self.radius_at(z);
+            let rho = (p.x * p.x + p.y * p.y).sqrt();
+            let (x, y) = if rho > 0.0 {
+                (p.x * r / rho, p.y * r / rho)
+            } else {
+                (p.x, p.y)
+            };
+            let p = Vec3::new(x, y, z);
+            // ∇(x² + y² − (r₀ + k·z)²) ∝ (x, y, −k·r(z)).
+            let n = Vec3::new(x, y, -self.slope() * r).normalized();
+            let phi = y.atan2(x);
+            let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
+            let err = (p.abs() + Vec3::splat(r)) * gamma(8);
+            SurfaceGeometry::flat(p, err, n, [phi / (2.0 * PI), z / self.height])
+        } else {
+            let (z, n) = if hit.part == BOTTOM {
+                (0.0, -Vec3::Z)
+            } else {
+                (self.height, Vec3::Z)
+            };
+            let p = Vec3::new(p.x, p.y, z);
+            let r = if hit.part == BOTTOM {
+                self.radius0
+            } else {
+                self.radius1
+            };
+            let uv = [0.5 + p.x / (2.0 * r), 0.5 + p.y / (2.0 * r)];
+            SurfaceGeometry::flat(p, p.abs() * gamma(4), n, uv)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn side_hit_and_normal_of_a_cone() {
+        // Radius 1 at z = 0 shrinking to 0 at z = 1: the side is at 45°.
+        let cone = Cone {
+            radius0: 1.0,
+            radius1: 0.0,
+            height: 1.0,
+            capped: false,
+        };
+        let ray = Ray::new(Vec3::new(-5.0, 0.0, 0.5), Vec3::X);
+        let hit = cone.intersect(&ray, 1e9).unwrap();
+        assert!((hit.t - 4.5).abs() < 1e-12);
+        let g = cone.surface(&ray, &hit);
+        let s = 0.5f64.sqrt();
+        assert!((g.n - Vec3::new(-s, 0.0, s)).length() < 1e-12, "{:?}", g.n);
+    }
+
+    #[test]
+    fn cap_hit_only_when_capped() {
+        let mut cone = Cone {
+            radius0: 1.0,
+            radius1: 0.5,
+            height: 2.0,
+            capped: false,
+        };
+        let ray = Ray::new(Vec3::new(0.1, 0.0, 5.0), -Vec3::Z);
+        // Open: the ray passes down the axis and leaves through the open bottom.
+        assert!(cone.intersect(&ray, 1e9).is_none());
+        cone.capped = true;
+        let hit = cone.intersect(&ray, 1e9).unwrap();
+        assert!((hit.t - 3.0).abs() < 1e-12);
+        assert_eq!(cone.surface(&ray, &hit).n, Vec3::Z);
+    }
+}

@@ -1,0 +1,81 @@
+//! A flat disk: the points of a plane within `radius` of `center`.
+
+use super::{plane_distance, project_onto_plane, HitRecord, SurfaceGeometry};
+use crate::math::{Bounds3, Ray, Vec3};
+use std::f64::consts::PI;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Disk {
+    pub center: Vec3,
+    /// Unit normal.
+    pub normal: Vec3,
+    pub radius: f64,
+    tangent_s: Vec3,
+    tangent_t: Vec3,
+}
+
+impl Disk {
+    pub fn new(center: Vec3, normal: Vec3, radius: f64) -> Self {
+        let normal = normal.normalized();
+        let (tangent_s, tangent_t) = normal.orthonormal_basis();
+        Disk {
+            center,
+            normal,
+            radius,
+            tangent_s,
+            tangent_t,
+        }
+    }
+
+    pub fn bounds(&self) -> Bounds3 {
+        // Extent along each axis of a circle with normal n: r·√(1 − n_axis²).
+        let n = self.normal;
+        let e = Vec3::new(
+            (1.0 - n.x * n.x).max(0.0).sqrt(),
+            (1.0 - n.y * n.y).max(0.0).sqrt(),
+            (1.0 - n.z * n.z).max(0.0).sqrt(),
+        ) * self.radius;
+        Bounds3::new(self.center - e, self.center + e)
+    }
+
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
+        let t = plane_distance(ray, self.normal, self.normal.dot(self.center), t_max)?;
+        let d = ray.at(t) - self.center;
+        (d.length_squared() <= self.radius * self.radius).then_some(HitRecord {
+            t,
+            u: 0.0,
+            v: 0.0,
+            part: 0,
+        })
+    }
+
+    pub fn surface(&self, ray: &Ray, hit: &HitRecord) -> SurfaceGeometry {
+        let (p, p_error) =
+            project_onto_plane(ray, hit.t, self.normal, self.normal.dot(self.center));
+        let d = p - self.center;
+        let (x, y) = (d.dot(self.tangent_s), d.dot(self.tangent_t));
+        let phi = y.atan2(x);
+        let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
+        let uv = [phi / (2.0 * PI), (x * x + y * y).sqrt() / self.radius];
+        SurfaceGeometry::flat(p, p_error, self.normal, uv)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hits_inside_radius_only() {
+        let disk = Disk::new(Vec3::new(0.0, 0.0, 2.0), -Vec3::Z, 1.0);
+        let hit = disk
+            .intersect(&Ray::new(Vec3::new(0.5, 0.5, 0.0), Vec3::Z), 1e9)
+            .unwrap();
+        assert!((hit.t - 2.0).abs() < 1e-15);
+        assert!(disk
+            .intersect(&Ray::new(Vec3::new(0.8, 0.8, 0.0), Vec3::Z), 1e9)
+            .is_none());
+        let b = disk.bounds();
+        assert!((b.max.x - 1.0).abs() < 1e-15 && (b.max.z - 2.0).abs() < 1e-15);
+    }
+}

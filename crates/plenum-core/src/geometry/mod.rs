@@ -1,0 +1,189 @@
+//! Shapes: the surfaces rays hit.
+//!
+//! Every shape answers two questions, in two phases so that the closest-hit search stays
+//! cheap: `intersect` finds the nearest parametric distance t in (0, t_max) and a few numbers
+//! to remember the hit by ([`HitRecord`]); `surface` then rebuilds the full
+//! [`SurfaceGeometry`] for the one hit that wins. Each `surface` also bounds the rounding
+//! error of the point it returns (see [`crate::math::float`]).
+//!
+//! Shapes live in their own coordinates; a [`crate::scene::Primitive`] adds the transform.
+//! Normals from `surface` are geometric, unit length and point *out* of solids (for planar
+//! shapes: along the normal the scene gave); the integrator flips them toward the viewer.
+
+mod cone;
+mod cuboid;
+mod cylinder;
+mod disk;
+pub mod mesh;
+mod plane;
+mod polygon;
+mod polyhedron;
+mod sphere;
+
+pub use cone::Cone;
+pub use cuboid::Cuboid;
+pub use cylinder::Cylinder;
+pub use disk::Disk;
+pub use mesh::TriangleMesh;
+pub use plane::Plane;
+pub use polygon::{Polygon, PolygonError};
+pub use polyhedron::{Polyhedron, PolyhedronError};
+pub use sphere::Sphere;
+
+use crate::math::{Bounds3, Ray, Vec3};
+use std::sync::Arc;
+
+/// What the closest-hit search remembers of a candidate hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HitRecord {
+    /// Distance along the ray, in units of |direction|.
+    pub t: f64,
+    /// Shape-specific surface coordinates (barycentrics for triangles).
+    pub u: f64,
+    pub v: f64,
+    /// Which part was hit: a face of a polyhedron or box, a triangle of a mesh, a cap.
+    pub part: u32,
+}
+
+/// The local geometry at a hit, in the shape's coordinates.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceGeometry {
+    pub p: Vec3,
+    /// Conservative bound on the absolute rounding error of `p`, per axis.
+    pub p_error: Vec3,
+    /// Unit geometric normal, outward for solids.
+    pub n: Vec3,
+    /// Unit shading normal (interpolated vertex normals for smooth meshes), same side as `n`.
+    pub shading_n: Vec3,
+    /// Texture coordinates.
+    pub uv: [f64; 2],
+}
+
+impl SurfaceGeometry {
+    fn flat(p: Vec3, p_error: Vec3, n: Vec3, uv: [f64; 2]) -> Self {
+        SurfaceGeometry {
+            p,
+            p_error,
+            n,
+            shading_n: n,
+            uv,
+        }
+    }
+}
+
+/// The closed set of shapes, dispatched by `match` (no virtual calls on the hot path).
+#[derive(Clone, Debug)]
+pub enum Shape {
+    Sphere(Sphere),
+    Plane(Plane),
+    Disk(Disk),
+    Cuboid(Cuboid),
+    Cylinder(Cylinder),
+    Cone(Cone),
+    Polygon(Box<Polygon>),
+    Polyhedron(Box<Polyhedron>),
+    /// A triangle mesh, shared by every instance that places it.
+    Mesh(Arc<TriangleMesh>),
+}
+
+impl Shape {
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
+        match self {
+            Shape::Sphere(s) => s.intersect(ray, t_max),
+            Shape::Plane(s) => s.intersect(ray, t_max),
+            Shape::Disk(s) => s.intersect(ray, t_max),
+            Shape::Cuboid(s) => s.intersect(ray, t_max),
+            Shape::Cylinder(s) => s.intersect(ray, t_max),
+            Shape::Cone(s) => s.intersect(ray, t_max),
+            Shape::Polygon(s) => s.intersect(ray, t_max),
+            Shape::Polyhedron(s) => s.intersect(ray, t_max),
+            Shape::Mesh(s) => s.intersect(ray, t_max),
+        }
+    }
+
+    pub fn surface(&self, ray: &Ray, hit: &HitRecord) -> SurfaceGeometry {
+        match self {
+            Shape::Sphere(s) => s.surface(ray, hit),
+            Shape::Plane(s) => s.surface(ray, hit),
+            Shape::Disk(s) => s.surface(ray, hit),
+            Shape::Cuboid(s) => s.surface(ray, hit),
+            Shape::Cylinder(s) => s.surface(ray, hit),
+            Shape::Cone(s) => s.surface(ray, hit),
+            Shape::Polygon(s) => s.surface(ray, hit),
+            Shape::Polyhedron(s) => s.surface(ray, hit),
+            Shape::Mesh(s) => s.surface(ray, hit),
+        }
+    }
+
+    /// Bounds in the shape's coordinates; `None` for unbounded shapes (the infinite plane).
+    pub fn bounds(&self) -> Option<Bounds3> {
+        match self {
+            Shape::Sphere(s) => Some(s.bounds()),
+            Shape::Plane(_) => None,
+            Shape::Disk(s) => Some(s.bounds()),
+            Shape::Cuboid(s) => Some(s.bounds()),
+            Shape::Cylinder(s) => Some(s.bounds()),
+            Shape::Cone(s) => Some(s.bounds()),
+            Shape::Polygon(s) => Some(s.bounds()),
+            Shape::Polyhedron(s) => Some(s.bounds()),
+            Shape::Mesh(s) => Some(s.bounds()),
+        }
+    }
+
+    /// A lower-case word for messages and the ray tree.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Shape::Sphere(_) => "sphere",
+            Shape::Plane(_) => "plane",
+            Shape::Disk(_) => "disk",
+            Shape::Cuboid(_) => "box",
+            Shape::Cylinder(_) => "cylinder",
+            Shape::Cone(_) => "cone",
+            Shape::Polygon(_) => "polygon",
+            Shape::Polyhedron(_) => "polyhedron",
+            Shape::Mesh(_) => "mesh",
+        }
+    }
+}
+
+/// Solves the quadratic of a quadric and returns the nearest root in (0, t_max) that
+/// `accept` admits (a height test for finite cylinders and cones).
+fn nearest_root(
+    roots: Option<(f64, f64)>,
+    t_max: f64,
+    accept: impl Fn(f64) -> bool,
+) -> Option<f64> {
+    let (t0, t1) = roots?;
+    [t0, t1]
+        .into_iter()
+        .find(|&t| t > 0.0 && t < t_max && accept(t))
+}
+
+/// Intersection of a ray with the plane n·p = dist, in (0, t_max).
+fn plane_distance(ray: &Ray, n: Vec3, dist: f64, t_max: f64) -> Option<f64> {
+    let denom = n.dot(ray.direction);
+    if denom == 0.0 {
+        return None;
+    }
+    let t = (dist - n.dot(ray.origin)) / denom;
+    (t > 0.0 && t < t_max).then_some(t)
+}
+
+/// The point o + t·d moved onto the plane n·p = dist (n unit), with its error bound. The
+/// projection removes the error of t along the normal, which is the error that matters.
+fn project_onto_plane(ray: &Ray, t: f64, n: Vec3, dist: f64) -> (Vec3, Vec3) {
+    let p = ray.at(t);
+    let p = p - n * (n.dot(p) - dist);
+    let scale = n.abs().dot(p.abs()) + dist.abs();
+    let err = (p.abs() + n.abs() * scale) * crate::math::gamma(8);
+    (p, err)
+}
+
+#[cfg(test)]
+pub(crate) mod test_util {
+    use crate::math::Vec3;
+
+    pub fn assert_close(a: Vec3, b: Vec3, tol: f64) {
+        assert!((a - b).length() <= tol, "{a:?} != {b:?} (tolerance {tol})");
+    }
+}

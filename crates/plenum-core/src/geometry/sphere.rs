@@ -1,0 +1,116 @@
+//! Spheres, with the numerically robust quadratic of Haines et al., "Precision improvements
+//! for ray/sphere intersection" (Ray Tracing Gems, ch. 7): the discriminant is computed from
+//! the ray's perpendicular offset to the centre, which stays accurate for far or huge spheres.
+
+use super::{nearest_root, HitRecord, SurfaceGeometry};
+use crate::math::{gamma, Bounds3, Ray, Vec3};
+use std::f64::consts::PI;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    pub center: Vec3,
+    pub radius: f64,
+}
+
+impl Sphere {
+    pub fn new(center: Vec3, radius: f64) -> Self {
+        Sphere { center, radius }
+    }
+
+    pub fn bounds(&self) -> Bounds3 {
+        Bounds3::new(
+            self.center - Vec3::splat(self.radius),
+            self.center + Vec3::splat(self.radius),
+        )
+    }
+
+    /// Both roots of |o + t·d − c|² = r², ascending, or `None` when the ray misses.
+    pub fn roots(&self, ray: &Ray) -> Option<(f64, f64)> {
+        let f = ray.origin - self.center;
+        let d = ray.direction;
+        let a = d.length_squared();
+        let half_b = -f.dot(d);
+        // Perpendicular from the centre to the ray's line: |l|² is exact where b² − ac is not.
+        let l = f + d * (half_b / a);
+        let r = self.radius;
+        let discriminant = a * (r - l.length()) * (r + l.length());
+        if discriminant < 0.0 {
+            return None;
+        }
+        let f_len = f.length();
+        let c = (f_len - r) * (f_len + r);
+        let q = half_b + discriminant.sqrt().copysign(half_b);
+        let (t0, t1) = if q == 0.0 { (0.0, 0.0) } else { (c / q, q / a) };
+        Some((t0.min(t1), t0.max(t1)))
+    }
+
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
+        let t = nearest_root(self.roots(ray), t_max, |_| true)?;
+        Some(HitRecord {
+            t,
+            u: 0.0,
+            v: 0.0,
+            part: 0,
+        })
+    }
+
+    pub fn surface(&self, ray: &Ray, hit: &HitRecord) -> SurfaceGeometry {
+        // Re-project onto the sphere: removes the error of t (pbrt-v4 §6.8.5).
+        let offset = ray.at(hit.t) - self.center;
+        let offset = offset * (self.radius / offset.length());
+        let p = self.center + offset;
+        let p_error = (offset.abs() + self.center.abs()) * gamma(8);
+        let n = offset / self.radius;
+        let phi = n.y.atan2(n.x);
+        let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
+        let uv = [phi / (2.0 * PI), n.z.clamp(-1.0, 1.0).acos() / PI];
+        SurfaceGeometry::flat(p, p_error, n, uv)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_util::assert_close;
+    use super::*;
+
+    #[test]
+    fn hit_distance_and_normal_match_closed_form() {
+        let s = Sphere::new(Vec3::new(0.0, 0.0, 5.0), 2.0);
+        let ray = Ray::new(Vec3::new(1.0, 0.0, 0.0), Vec3::Z);
+        let hit = s.intersect(&ray, f64::INFINITY).unwrap();
+        // z = 5 − √(4 − 1)
+        assert!((hit.t - (5.0 - 3f64.sqrt())).abs() < 1e-12);
+        let g = s.surface(&ray, &hit);
+        assert_close(g.n, Vec3::new(0.5, 0.0, -(3f64.sqrt()) / 2.0), 1e-12);
+    }
+
+    #[test]
+    fn ray_from_inside_hits_the_far_side() {
+        let s = Sphere::new(Vec3::ZERO, 1.0);
+        let hit = s.intersect(&Ray::new(Vec3::ZERO, Vec3::X), f64::INFINITY).unwrap();
+        assert!((hit.t - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn misses_and_respects_t_max() {
+        let s = Sphere::new(Vec3::new(0.0, 0.0, 5.0), 1.0);
+        assert!(s.intersect(&Ray::new(Vec3::new(2.0, 0.0, 0.0), Vec3::Z), 1e9).is_none());
+        assert!(s.intersect(&Ray::new(Vec3::ZERO, Vec3::Z), 3.0).is_none());
+        assert!(s.intersect(&Ray::new(Vec3::ZERO, -Vec3::Z), 1e9).is_none());
+    }
+
+    #[test]
+    fn huge_far_sphere_has_no_cancellation() {
+        // A sphere of radius 1e6 seen from 1e7 away, grazing at 0.5 unit inside its rim:
+        // the schoolbook discriminant b² − 4ac loses every digit here.
+        let r = 1e6;
+        let s = Sphere::new(Vec3::new(0.0, 0.0, 1e7), r);
+        let x = r - 0.5;
+        let ray = Ray::new(Vec3::new(x, 0.0, 0.0), Vec3::Z);
+        let hit = s.intersect(&ray, f64::INFINITY).unwrap();
+        let exact = 1e7 - (r * r - x * x).sqrt();
+        assert!((hit.t - exact).abs() < 1e-6, "{} vs {exact}", hit.t);
+        let g = s.surface(&ray, &hit);
+        assert!(((g.p - s.center).length() - r).abs() < 1e-8);
+    }
+}
