@@ -4,5 +4,19 @@
 //! arrive already built (see `plenum-scene`); images leave as a [`film::Film`] of linear RGB.
 
 pub mod accel;
+pub mod camera;
+pub mod color;
+pub mod film;
 pub mod geometry;
+pub mod integrator;
+pub mod light;
+pub mod material;
 pub mod math;
+pub mod optics;
+pub mod render;
+pub mod sampling;
+pub mod scene;
+pub mod texture;
+
+pub use color::Color;
+pub use math::Vec3;

@@ -1,0 +1,131 @@
+//! The ray tree of one pixel, as drawn in the lecture: every ray the integrator traced, with
+//! what it hit, what it returned, and why its branch ended.
+
+use crate::color::Color;
+use crate::math::Vec3;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayKind {
+    Camera,
+    Shadow,
+    Reflected,
+    Refracted,
+}
+
+impl RayKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            RayKind::Camera => "camera",
+            RayKind::Shadow => "shadow",
+            RayKind::Reflected => "reflected",
+            RayKind::Refracted => "refracted",
+        }
+    }
+}
+
+/// Why the recursion ended at a node, or skipped one of its branches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stop {
+    /// The ray left the scene; it returned the background.
+    Miss,
+    /// A secondary ray was due but the maximum depth was reached.
+    Depth,
+    /// A secondary ray's weight in the pixel fell below the threshold.
+    Weight,
+    /// The surface neither reflects nor transmits: a leaf of the tree.
+    Opaque,
+}
+
+impl Stop {
+    pub fn name(self) -> &'static str {
+        match self {
+            Stop::Miss => "miss",
+            Stop::Depth => "depth",
+            Stop::Weight => "weight",
+            Stop::Opaque => "no reflection or transmission",
+        }
+    }
+}
+
+/// What a shadow ray found on its way to a light.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShadowInfo {
+    pub light: String,
+    /// Objects between the point and the light, nearest first.
+    pub occluders: Vec<String>,
+    /// An opaque occluder stopped the light.
+    pub blocked: bool,
+    /// S_L: the product of the transmissive occluders' k_t (zero when blocked).
+    pub transmittance: Color,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct RayNode {
+    pub parent: Option<usize>,
+    pub kind: RayKind,
+    pub depth: u32,
+    pub origin: Vec3,
+    /// Unit direction.
+    pub direction: Vec3,
+    /// The ray's weight in the pixel: the product of the coefficients along its path.
+    pub weight: Color,
+    /// Object and material hit, for camera, reflected and refracted rays.
+    pub object: Option<String>,
+    pub material: Option<String>,
+    /// Distance to the hit (to the light for shadow rays).
+    pub distance: Option<f64>,
+    /// Radiance the ray returned.
+    pub color: Color,
+    pub stops: Vec<Stop>,
+    /// At this hit the refracted ray was totally internally reflected.
+    pub total_internal_reflection: bool,
+    pub shadow: Option<ShadowInfo>,
+}
+
+impl RayNode {
+    pub fn new(
+        parent: Option<usize>,
+        kind: RayKind,
+        depth: u32,
+        origin: Vec3,
+        direction: Vec3,
+        weight: Color,
+    ) -> Self {
+        RayNode {
+            parent,
+            kind,
+            depth,
+            origin,
+            direction: direction.normalized(),
+            weight,
+            object: None,
+            material: None,
+            distance: None,
+            color: Color::BLACK,
+            stops: Vec::new(),
+            total_internal_reflection: false,
+            shadow: None,
+        }
+    }
+}
+
+/// Nodes in the order they were traced; children point to their parent.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RayTree {
+    pub nodes: Vec<RayNode>,
+}
+
+impl RayTree {
+    pub fn push(&mut self, node: RayNode) -> usize {
+        self.nodes.push(node);
+        self.nodes.len() - 1
+    }
+
+    pub fn children(&self, parent: usize) -> impl Iterator<Item = usize> + '_ {
+        self.nodes
+            .iter()
+            .enumerate()
+            .filter(move |(_, n)| n.parent == Some(parent))
+            .map(|(i, _)| i)
+    }
+}

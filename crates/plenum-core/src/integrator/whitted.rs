@@ -1,0 +1,286 @@
+//! Whitted's recursive ray tracing (Whitted 1980), as the lecture's pseudocode states it:
+//!
+//! I = k_e + k_a·I_a + Σ_L S_L·f(d)·I_L·(k_d·max(0, N·L) + k_s·max(0, R·V)^n)
+//!     + k_r·I(reflected ray) + k_t·I(refracted ray)
+//!
+//! S_L comes from a shadow ray to every light: 1 when nothing is in the way, the product of
+//! the occluders' k_t when they are transmissive, 0 behind an opaque one. Recursion stops at
+//! the maximum depth and when a ray's weight in the pixel drops below a threshold (Hall and
+//! Greenberg 1983). On total internal reflection the refracted weight goes to reflection.
+
+use super::{MediumStack, RayKind, RayNode, RayTree, ShadowInfo, Stop};
+use crate::color::Color;
+use crate::light::Incident;
+use crate::math::{offset_ray_origin, Ray};
+use crate::optics::{fresnel_dielectric, reflect, refract};
+use crate::scene::{Interaction, Scene};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WhittedConfig {
+    /// Bounces of reflection and refraction after the camera ray (0: direct light only).
+    pub max_depth: u32,
+    /// Rays whose weight in the pixel (largest RGB component) falls below this are not traced.
+    pub min_weight: f64,
+}
+
+impl Default for WhittedConfig {
+    fn default() -> Self {
+        WhittedConfig {
+            max_depth: 5,
+            min_weight: 1.0 / 256.0,
+        }
+    }
+}
+
+/// Rays traced, by kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCounts {
+    pub camera: u64,
+    pub shadow: u64,
+    pub reflection: u64,
+    pub refraction: u64,
+}
+
+impl RayCounts {
+    pub fn total(&self) -> u64 {
+        self.camera + self.shadow + self.reflection + self.refraction
+    }
+
+    pub fn add(&mut self, o: &RayCounts) {
+        self.camera += o.camera;
+        self.shadow += o.shadow;
+        self.reflection += o.reflection;
+        self.refraction += o.refraction;
+    }
+}
+
+/// Shadow rays give up after this many transmissive occluders (a stack of glass panes).
+const MAX_SHADOW_SEGMENTS: usize = 64;
+/// Shadow rays to a point light stop just short of it.
+const SHADOW_END: f64 = 1.0 - 1e-9;
+
+pub struct Whitted<'a> {
+    scene: &'a Scene,
+    config: WhittedConfig,
+}
+
+/// One ray to trace, with where it sits in the tree.
+struct Branch<'t> {
+    kind: RayKind,
+    depth: u32,
+    weight: Color,
+    media: MediumStack,
+    tree: Option<&'t mut RayTree>,
+    parent: Option<usize>,
+}
+
+impl<'a> Whitted<'a> {
+    pub fn new(scene: &'a Scene, config: WhittedConfig) -> Self {
+        Whitted { scene, config }
+    }
+
+    /// Radiance along a camera ray. With `tree`, every ray traced is recorded in it.
+    pub fn camera_ray(&self, ray: &Ray, counts: &mut RayCounts, tree: Option<&mut RayTree>) -> Color {
+        counts.camera += 1;
+        let branch = Branch {
+            kind: RayKind::Camera,
+            depth: 0,
+            weight: Color::WHITE,
+            media: MediumStack::default(),
+            tree,
+            parent: None,
+        };
+        self.trace(ray, branch, counts)
+    }
+
+    fn trace(&self, ray: &Ray, mut b: Branch, counts: &mut RayCounts) -> Color {
+        let node = b.tree.as_deref_mut().map(|t| {
+            t.push(RayNode::new(
+                b.parent,
+                b.kind,
+                b.depth,
+                ray.origin,
+                ray.direction,
+                b.weight,
+            ))
+        });
+        let Some((prim, hit)) = self.scene.intersect(ray, f64::INFINITY) else {
+            if let (Some(t), Some(i)) = (b.tree.as_deref_mut(), node) {
+                t.nodes[i].stops.push(Stop::Miss);
+                t.nodes[i].color = self.scene.background;
+            }
+            return self.scene.background;
+        };
+        let it = self.scene.interaction(ray, prim, &hit);
+        let material = self.scene.material_of(prim);
+        let k = material.evaluate(&it.texture);
+        if let (Some(t), Some(i)) = (b.tree.as_deref_mut(), node) {
+            let n = &mut t.nodes[i];
+            n.object = Some(self.scene.object_names[prim as usize].clone());
+            let m = self.scene.primitives[prim as usize].material as usize;
+            n.material = Some(self.scene.material_names[m].clone());
+            n.distance = Some(hit.t * ray.direction.length());
+        }
+
+        let d = ray.direction.normalized();
+        let v = -d;
+        let entering = d.dot(it.n) < 0.0;
+        // Normals on the side the ray arrives from.
+        let n = if entering { it.n } else { -it.n };
+        let ns = it.shading_n.face_forward(n);
+
+        // Local illumination: emission, ambient, and Phong from every light.
+        let mut color = k.emissive + k.ambient * self.scene.ambient;
+        for (li, light) in self.scene.lights.iter().enumerate() {
+            let Some(inc) = light.incident(it.p) else {
+                continue;
+            };
+            let cos = ns.dot(inc.wi);
+            if cos <= 0.0 || n.dot(inc.wi) <= 0.0 {
+                continue;
+            }
+            let s = self.shadow(&it, n, &inc, li, &mut b, node, counts);
+            if s.is_black() {
+                continue;
+            }
+            let r = reflect(-inc.wi, ns);
+            let specular = r.dot(v).max(0.0).powf(k.shininess);
+            color += s * inc.intensity * (k.diffuse * cos + k.specular * specular);
+        }
+
+        // Global illumination: the reflected and refracted rays.
+        let (eta_i, eta_t, media_t) = if entering {
+            (b.media.ior(), k.ior, b.media.entered(prim, k.ior))
+        } else {
+            let outside = b.media.left(prim);
+            (k.ior, outside.ior(), outside)
+        };
+        let (mut kr, mut kt) = (k.reflective, k.transmissive);
+        if kr.is_black() && kt.is_black() {
+            record(&mut b, node, |n| n.stops.push(Stop::Opaque));
+        }
+        if k.fresnel {
+            let f = fresnel_dielectric(v.dot(n), eta_i, eta_t);
+            kr = kr * f;
+            kt = kt * (1.0 - f);
+        }
+        let refracted = if kt.is_black() {
+            None
+        } else {
+            let t = refract(d, n, eta_i / eta_t);
+            if t.is_none() {
+                kr += kt;
+                kt = Color::BLACK;
+                record(&mut b, node, |n| n.total_internal_reflection = true);
+            }
+            t
+        };
+        let secondary = [
+            (RayKind::Reflected, kr, Some(reflect(d, n)), b.media),
+            (RayKind::Refracted, kt, refracted, media_t),
+        ];
+        for (kind, coefficient, direction, media) in secondary {
+            let Some(direction) = direction.filter(|_| !coefficient.is_black()) else {
+                continue;
+            };
+            if b.depth >= self.config.max_depth {
+                record(&mut b, node, |n| n.stops.push(Stop::Depth));
+                continue;
+            }
+            let weight = b.weight * coefficient;
+            if weight.max_component() < self.config.min_weight {
+                record(&mut b, node, |n| n.stops.push(Stop::Weight));
+                continue;
+            }
+            match kind {
+                RayKind::Reflected => counts.reflection += 1,
+                _ => counts.refraction += 1,
+            }
+            let origin = offset_ray_origin(it.p, it.p_error, n, direction);
+            let child = Branch {
+                kind,
+                depth: b.depth + 1,
+                weight,
+                media,
+                tree: b.tree.as_deref_mut(),
+                parent: node,
+            };
+            color += coefficient * self.trace(&Ray::new(origin, direction), child, counts);
+        }
+        record(&mut b, node, |n| n.color = color);
+        color
+    }
+
+    /// S_L for one light: 1, the product of the transmissive occluders' k_t, or 0.
+    #[allow(clippy::too_many_arguments)]
+    fn shadow(
+        &self,
+        it: &Interaction,
+        n: crate::math::Vec3,
+        inc: &Incident,
+        light: usize,
+        b: &mut Branch,
+        parent: Option<usize>,
+        counts: &mut RayCounts,
+    ) -> Color {
+        let mut origin = offset_ray_origin(it.p, it.p_error, n, inc.wi);
+        let start = origin;
+        let mut s = Color::WHITE;
+        let mut occluders = Vec::new();
+        let recording = b.tree.is_some();
+        let mut blocked = false;
+        for _ in 0..MAX_SHADOW_SEGMENTS {
+            counts.shadow += 1;
+            let (direction, t_max) = match inc.position {
+                Some(light_at) => (light_at - origin, SHADOW_END),
+                None => (inc.wi, f64::INFINITY),
+            };
+            let ray = Ray::new(origin, direction);
+            let Some((prim, hit)) = self.scene.intersect(&ray, t_max) else {
+                break;
+            };
+            if recording {
+                occluders.push(self.scene.object_names[prim as usize].clone());
+            }
+            let material = self.scene.material_of(prim);
+            if !material.is_transmissive() {
+                blocked = true;
+                break;
+            }
+            let occ = self.scene.interaction(&ray, prim, &hit);
+            s *= material.transmissive.evaluate(&occ.texture);
+            if s.is_black() {
+                blocked = true;
+                break;
+            }
+            origin = offset_ray_origin(occ.p, occ.p_error, occ.n, direction);
+        }
+        let s = if blocked { Color::BLACK } else { s };
+        if let Some(t) = b.tree.as_deref_mut() {
+            let mut node = RayNode::new(
+                parent,
+                RayKind::Shadow,
+                b.depth + 1,
+                start,
+                inc.wi,
+                b.weight,
+            );
+            node.distance = Some(inc.distance);
+            node.color = s * inc.intensity;
+            node.shadow = Some(ShadowInfo {
+                light: self.scene.light_names[light].clone(),
+                occluders,
+                blocked,
+                transmittance: s,
+            });
+            t.push(node);
+        }
+        s
+    }
+}
+
+fn record(b: &mut Branch, node: Option<usize>, f: impl FnOnce(&mut RayNode)) {
+    if let (Some(t), Some(i)) = (b.tree.as_deref_mut(), node) {
+        f(&mut t.nodes[i]);
+    }
+}

@@ -1,0 +1,78 @@
+//! The lecture's Phong material for Whitted ray tracing. Every coefficient may be textured.
+
+use crate::color::Color;
+use crate::texture::{Texture, TextureCoords};
+
+#[derive(Clone, Debug)]
+pub struct Material {
+    /// k_e: light the surface emits on its own.
+    pub emissive: Texture,
+    /// k_a: response to the scene's ambient light.
+    pub ambient: Texture,
+    /// k_d: Lambertian diffuse reflectance.
+    pub diffuse: Texture,
+    /// k_s: Phong specular reflectance.
+    pub specular: Texture,
+    /// n: the Phong exponent.
+    pub shininess: f64,
+    /// k_r: mirror reflectance.
+    pub reflective: Texture,
+    /// k_t: transmittance of refracted light.
+    pub transmissive: Texture,
+    /// η: index of refraction of the solid's interior.
+    pub ior: f64,
+    /// Scale k_r and k_t by the dielectric Fresnel reflectance F and 1 − F.
+    pub fresnel: bool,
+}
+
+impl Default for Material {
+    /// A matte grey.
+    fn default() -> Self {
+        Material {
+            emissive: Texture::Constant(Color::BLACK),
+            ambient: Texture::Constant(Color::BLACK),
+            diffuse: Texture::Constant(Color::gray(0.8)),
+            specular: Texture::Constant(Color::BLACK),
+            shininess: 32.0,
+            reflective: Texture::Constant(Color::BLACK),
+            transmissive: Texture::Constant(Color::BLACK),
+            ior: 1.0,
+            fresnel: false,
+        }
+    }
+}
+
+/// A material's coefficients evaluated at one point.
+#[derive(Clone, Copy, Debug)]
+pub struct Coefficients {
+    pub emissive: Color,
+    pub ambient: Color,
+    pub diffuse: Color,
+    pub specular: Color,
+    pub shininess: f64,
+    pub reflective: Color,
+    pub transmissive: Color,
+    pub ior: f64,
+    pub fresnel: bool,
+}
+
+impl Material {
+    pub fn evaluate(&self, at: &TextureCoords) -> Coefficients {
+        Coefficients {
+            emissive: self.emissive.evaluate(at),
+            ambient: self.ambient.evaluate(at),
+            diffuse: self.diffuse.evaluate(at),
+            specular: self.specular.evaluate(at),
+            shininess: self.shininess,
+            reflective: self.reflective.evaluate(at),
+            transmissive: self.transmissive.evaluate(at),
+            ior: self.ior,
+            fresnel: self.fresnel,
+        }
+    }
+
+    /// Light can pass through: shadow rays continue and rays may start inside.
+    pub fn is_transmissive(&self) -> bool {
+        !self.transmissive.is_black()
+    }
+}

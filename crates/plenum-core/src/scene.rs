@@ -1,0 +1,234 @@
+//! A scene ready to render: primitives in a BVH, materials, lights, camera and background.
+//! Built once by [`SceneBuilder`]; immutable and shared by every render thread.
+
+use crate::accel::Bvh;
+use crate::camera::CameraSettings;
+use crate::color::Color;
+use crate::geometry::{HitRecord, Shape};
+use crate::light::Light;
+use crate::material::Material;
+use crate::math::{Bounds3, Ray, Transform, Vec3};
+use crate::texture::TextureCoords;
+
+/// Index of a material in [`Scene::materials`].
+pub type MaterialId = u32;
+
+/// A shape placed in the world with a material.
+#[derive(Clone, Debug)]
+pub struct Primitive {
+    pub shape: Shape,
+    /// Object-to-world transform; `None` when the shape is already in world coordinates.
+    pub to_world: Option<Box<Transform>>,
+    pub material: MaterialId,
+}
+
+/// Everything the integrator needs about a hit, in world space.
+#[derive(Clone, Copy, Debug)]
+pub struct Interaction {
+    pub p: Vec3,
+    pub p_error: Vec3,
+    /// Unit geometric normal, outward for solids.
+    pub n: Vec3,
+    /// Unit shading normal, on the same side as `n`.
+    pub shading_n: Vec3,
+    pub texture: TextureCoords,
+    pub primitive: u32,
+}
+
+impl Primitive {
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
+        match &self.to_world {
+            None => self.shape.intersect(ray, t_max),
+            Some(t) => {
+                let (local, dt) = t.ray_to_object(ray);
+                let mut hit = self.shape.intersect(&local, t_max - dt)?;
+                hit.t += dt;
+                Some(hit)
+            }
+        }
+    }
+
+    pub fn interaction(&self, ray: &Ray, hit: &HitRecord, primitive: u32) -> Interaction {
+        match &self.to_world {
+            None => {
+                let g = self.shape.surface(ray, hit);
+                Interaction {
+                    p: g.p,
+                    p_error: g.p_error,
+                    n: g.n,
+                    shading_n: g.shading_n,
+                    texture: TextureCoords {
+                        uv: g.uv,
+                        object_point: g.p,
+                    },
+                    primitive,
+                }
+            }
+            Some(t) => {
+                let (local, dt) = t.ray_to_object(ray);
+                let local_hit = HitRecord {
+                    t: hit.t - dt,
+                    ..*hit
+                };
+                let g = self.shape.surface(&local, &local_hit);
+                let (p, p_error) = t.point_with_error(g.p, g.p_error);
+                Interaction {
+                    p,
+                    p_error,
+                    n: t.normal(g.n).normalized(),
+                    shading_n: t.normal(g.shading_n).normalized(),
+                    texture: TextureCoords {
+                        uv: g.uv,
+                        object_point: g.p,
+                    },
+                    primitive,
+                }
+            }
+        }
+    }
+
+    pub fn world_bounds(&self) -> Option<Bounds3> {
+        let b = self.shape.bounds()?;
+        Some(match &self.to_world {
+            None => b,
+            Some(t) => Bounds3::from_points(b.corners().map(|c| t.point(c))),
+        })
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub camera: CameraSettings,
+    pub primitives: Vec<Primitive>,
+    /// A name per primitive, for the ray tree and messages.
+    pub object_names: Vec<String>,
+    pub materials: Vec<Material>,
+    pub material_names: Vec<String>,
+    pub lights: Vec<Light>,
+    pub light_names: Vec<String>,
+    /// I_a: the sum of the scene's ambient lights.
+    pub ambient: Color,
+    /// Radiance of rays that hit nothing.
+    pub background: Color,
+    bvh: Bvh,
+    /// Primitives without bounds (infinite planes), tested on every ray.
+    unbounded: Vec<u32>,
+}
+
+impl Scene {
+    /// The nearest hit in (0, t_max): the primitive's index and the hit.
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<(u32, HitRecord)> {
+        let mut best = self.bvh.intersect(ray, t_max, |i, t| {
+            self.primitives[self.bounded_index(i)].intersect(ray, t)
+        });
+        if let Some((i, _)) = &mut best {
+            *i = self.bounded_index(*i) as u32;
+        }
+        for &i in &self.unbounded {
+            let limit = best.map_or(t_max, |(_, h)| h.t);
+            if let Some(hit) = self.primitives[i as usize].intersect(ray, limit) {
+                best = Some((i, hit));
+            }
+        }
+        best
+    }
+
+    /// The BVH is built over bounded primitives in their original order, skipping planes.
+    fn bounded_index(&self, bvh_item: u32) -> usize {
+        // Unbounded primitives are few; counting those before the item keeps the mapping
+        // without a second table.
+        let mut index = bvh_item as usize;
+        for &u in &self.unbounded {
+            if (u as usize) <= index {
+                index += 1;
+            }
+        }
+        index
+    }
+
+    pub fn interaction(&self, ray: &Ray, primitive: u32, hit: &HitRecord) -> Interaction {
+        self.primitives[primitive as usize].interaction(ray, hit, primitive)
+    }
+
+    pub fn material_of(&self, primitive: u32) -> &Material {
+        &self.materials[self.primitives[primitive as usize].material as usize]
+    }
+
+    /// Bounds of all bounded primitives.
+    pub fn bounds(&self) -> Bounds3 {
+        self.bvh.bounds()
+    }
+}
+
+/// Collects the parts of a scene, then builds the acceleration structure.
+#[derive(Clone, Debug, Default)]
+pub struct SceneBuilder {
+    pub camera: CameraSettings,
+    pub background: Color,
+    pub ambient: Color,
+    primitives: Vec<Primitive>,
+    object_names: Vec<String>,
+    materials: Vec<Material>,
+    material_names: Vec<String>,
+    lights: Vec<Light>,
+    light_names: Vec<String>,
+}
+
+impl SceneBuilder {
+    pub fn add_material(&mut self, name: impl Into<String>, material: Material) -> MaterialId {
+        self.materials.push(material);
+        self.material_names.push(name.into());
+        (self.materials.len() - 1) as MaterialId
+    }
+
+    /// Places `shape` with an object-to-world transform (identity: none).
+    pub fn add_object(
+        &mut self,
+        name: impl Into<String>,
+        shape: Shape,
+        to_world: Transform,
+        material: MaterialId,
+    ) {
+        self.primitives.push(Primitive {
+            shape,
+            to_world: (!to_world.is_identity()).then(|| Box::new(to_world)),
+            material,
+        });
+        self.object_names.push(name.into());
+    }
+
+    pub fn add_light(&mut self, name: impl Into<String>, light: Light) {
+        self.lights.push(light);
+        self.light_names.push(name.into());
+    }
+
+    pub fn build(mut self) -> Scene {
+        // An opaque polyhedron is never entered, so its back faces can be culled.
+        for p in &mut self.primitives {
+            if let Shape::Polyhedron(poly) = &mut p.shape {
+                poly.cull_back_faces = !self.materials[p.material as usize].is_transmissive();
+            }
+        }
+        let mut bounds = Vec::new();
+        let mut unbounded = Vec::new();
+        for (i, p) in self.primitives.iter().enumerate() {
+            match p.world_bounds() {
+                Some(b) => bounds.push(b),
+                None => unbounded.push(i as u32),
+            }
+        }
+        Scene {
+            camera: self.camera,
+            bvh: Bvh::build(&bounds),
+            unbounded,
+            primitives: self.primitives,
+            object_names: self.object_names,
+            materials: self.materials,
+            material_names: self.material_names,
+            lights: self.lights,
+            light_names: self.light_names,
+            ambient: self.ambient,
+            background: self.background,
+        }
+    }
+}
