@@ -1,1 +1,225 @@
-fn main(){}
+//! The `plenum` command.
+//!
+//! Exit codes: 0 success; 1 an output file could not be written; 2 bad input (a scene error,
+//! a bad argument); 130 interrupted by Ctrl-C, after writing what was rendered.
+
+mod trace;
+
+use clap::{Args, Parser, Subcommand};
+use plenum_core::integrator::WhittedConfig;
+use plenum_core::render::{render, RenderSettings};
+use plenum_core::sampling::PixelSampler;
+use plenum_scene::{builtin_scene, load_scene, LoadedScene};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+#[derive(Parser)]
+#[command(name = "plenum", version, about = "Plenum: a ray tracer for learning, teaching and using ray tracing")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to an image (with no scene: Whitted's 1980 picture).
+    Render(RenderArgs),
+    /// Print the ray tree of one pixel: every ray traced for it and why each branch ended.
+    TracePixel(TracePixelArgs),
+}
+
+/// Settings shared by render and trace-pixel; each overrides the scene file's own.
+#[derive(Args, Clone, Default)]
+struct ViewArgs {
+    /// Image width in pixels.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels.
+    #[arg(long)]
+    height: Option<u32>,
+    /// Samples per pixel, on a regular √N×√N grid.
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Maximum number of reflection/refraction bounces.
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Random seed.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
+#[derive(Args, Default)]
+struct RenderArgs {
+    /// Scene file (.toml). Without one, the built-in scene.
+    scene: Option<PathBuf>,
+    /// Output image; the extension picks the format: .png, .exr, .pfm, .hdr.
+    #[arg(short, long, default_value = "plenum.png")]
+    output: PathBuf,
+    #[command(flatten)]
+    view: ViewArgs,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Exposure in stops, for PNG output.
+    #[arg(long)]
+    exposure: Option<f64>,
+    /// No progress bar and no summary.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+#[derive(Args)]
+struct TracePixelArgs {
+    /// Scene file (.toml); `-` for the built-in scene.
+    scene: PathBuf,
+    /// Pixel column, from the left.
+    x: u32,
+    /// Pixel row, from the top.
+    y: u32,
+    /// Print JSON instead of an indented tree.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    view: ViewArgs,
+}
+
+static CANCEL: AtomicBool = AtomicBool::new(false);
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    match cli.command.unwrap_or(Command::Render(RenderArgs {
+        output: PathBuf::from("plenum.png"),
+        ..Default::default()
+    })) {
+        Command::Render(args) => run_render(args),
+        Command::TracePixel(args) => trace::run(args),
+    }
+}
+
+/// Loads the scene, or prints its error; `None` means the built-in scene.
+fn load(path: Option<&Path>) -> Result<LoadedScene, ExitCode> {
+    match path {
+        None => Ok(builtin_scene()),
+        Some(p) if p.as_os_str() == "-" => Ok(builtin_scene()),
+        Some(p) => load_scene(p).map_err(|e| {
+            eprintln!("{e}");
+            ExitCode::from(2)
+        }),
+    }
+}
+
+fn settings(view: &ViewArgs, loaded: &LoadedScene) -> Result<RenderSettings, ExitCode> {
+    let d = &loaded.defaults;
+    let width = view.width.unwrap_or(d.width);
+    let height = view.height.unwrap_or(d.height);
+    if width == 0 || height == 0 {
+        eprintln!("error: the image must be at least 1×1 pixels");
+        return Err(ExitCode::from(2));
+    }
+    let spp = view.spp.unwrap_or(d.spp);
+    if spp == 0 {
+        eprintln!("error: --spp must be at least 1");
+        return Err(ExitCode::from(2));
+    }
+    let sampler = PixelSampler::grid_for(spp);
+    if sampler.samples_per_pixel() != spp {
+        eprintln!(
+            "warning: the regular grid needs a square sample count; using {} instead of {spp}",
+            sampler.samples_per_pixel()
+        );
+    }
+    Ok(RenderSettings {
+        width,
+        height,
+        sampler,
+        integrator: WhittedConfig {
+            max_depth: view.max_depth.unwrap_or(d.max_depth),
+            min_weight: d.min_weight,
+        },
+        seed: view.seed,
+    })
+}
+
+fn run_render(args: RenderArgs) -> ExitCode {
+    let loaded = match load(args.scene.as_deref()) {
+        Ok(l) => l,
+        Err(code) => return code,
+    };
+    let settings = match settings(&args.view, &loaded) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    if let Err(e) = plenum_image::OutputFormat::from_path(&args.output) {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
+    let threads = args.threads.unwrap_or(0);
+    let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: cannot start {threads} threads: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    // A second Ctrl-C is not caught: it ends the process at once.
+    let _ = ctrlc::set_handler(|| CANCEL.store(true, Ordering::SeqCst));
+
+    let show_progress = !args.quiet && std::io::stderr().is_terminal();
+    let bar = indicatif::ProgressBar::hidden();
+    if show_progress {
+        bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed} (eta {eta})")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+    }
+    let start = Instant::now();
+    let output = pool.install(|| {
+        render(&loaded.scene, &settings, &CANCEL, &|done, total| {
+            if show_progress {
+                bar.set_length(total as u64);
+                bar.set_position(done as u64);
+            }
+        })
+    });
+    let elapsed = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+
+    let exposure = args.exposure.unwrap_or(loaded.defaults.exposure) as f32;
+    let film = &output.film;
+    if let Err(e) = plenum_image::write_image(&args.output, film.width, film.height, film.pixels(), exposure) {
+        eprintln!("error: {e}");
+        return ExitCode::from(1);
+    }
+    if !args.quiet {
+        let c = &output.counts;
+        eprintln!(
+            "{}×{}, {} spp, {:.3} s, rays: {} camera, {} shadow, {} reflection, {} refraction; {:.2} Mrays/s → {}",
+            film.width,
+            film.height,
+            settings.sampler.samples_per_pixel(),
+            elapsed,
+            c.camera,
+            c.shadow,
+            c.reflection,
+            c.refraction,
+            c.total() as f64 / elapsed / 1e6,
+            args.output.display()
+        );
+    }
+    if !output.complete {
+        eprintln!("interrupted: wrote the part rendered so far to {}", args.output.display());
+        return ExitCode::from(130);
+    }
+    ExitCode::SUCCESS
+}

@@ -133,6 +133,27 @@ impl Scene {
         best
     }
 
+    /// Calls `visit(primitive, hit)` with each primitive's nearest hit in (0, t_max), in no
+    /// particular order, until `visit` returns false: an any-hit query for shadow rays.
+    pub fn for_each_hit(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(u32, &HitRecord) -> bool) {
+        let mut go_on = true;
+        self.bvh.for_each_candidate(ray, t_max, |i| {
+            let prim = self.bounded_index(i);
+            if let Some(hit) = self.primitives[prim].intersect(ray, t_max) {
+                go_on = visit(prim as u32, &hit);
+            }
+            go_on
+        });
+        for &i in &self.unbounded {
+            if !go_on {
+                return;
+            }
+            if let Some(hit) = self.primitives[i as usize].intersect(ray, t_max) {
+                go_on = visit(i, &hit);
+            }
+        }
+    }
+
     /// The BVH is built over bounded primitives in their original order, skipping planes.
     fn bounded_index(&self, bvh_item: u32) -> usize {
         // Unbounded primitives are few; counting those before the item keeps the mapping

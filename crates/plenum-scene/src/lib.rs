@@ -1,1 +1,69 @@
+//! Scene files for Plenum: the native TOML format (and the OBJ meshes it references), read
+//! with located diagnostics and built into a core [`plenum_core::scene::Scene`].
 
+pub mod diagnostics;
+mod native;
+mod obj;
+mod reader;
+
+pub use diagnostics::SceneError;
+use plenum_core::scene::Scene;
+use std::path::Path;
+
+/// Render settings a scene file may carry; the command line overrides them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderDefaults {
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub max_depth: u32,
+    pub min_weight: f64,
+    /// Stops of exposure applied before clamping to 8 bits.
+    pub exposure: f64,
+}
+
+impl Default for RenderDefaults {
+    fn default() -> Self {
+        RenderDefaults {
+            width: 640,
+            height: 480,
+            spp: 1,
+            max_depth: 5,
+            min_weight: 1.0 / 256.0,
+            exposure: 0.0,
+        }
+    }
+}
+
+/// A scene and the render settings its file asked for.
+pub struct LoadedScene {
+    pub scene: Scene,
+    pub defaults: RenderDefaults,
+}
+
+/// Reads a scene file; relative paths inside it are resolved against its folder.
+pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| SceneError::file(path, format!("cannot read the scene file: {e}")))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    parse_scene(path, &text, base)
+}
+
+/// Parses native scene text; `path` names it in messages, `base_dir` resolves relative paths.
+pub fn parse_scene(path: &Path, text: &str, base_dir: &Path) -> Result<LoadedScene, SceneError> {
+    let (builder, defaults) = native::parse(path, text, base_dir)?;
+    Ok(LoadedScene {
+        scene: builder.build(),
+        defaults,
+    })
+}
+
+/// The text of the built-in scene: Whitted's 1980 picture.
+pub const BUILTIN_SCENE: &str = include_str!("../../../scenes/whitted.toml");
+
+/// Whitted's 1980 picture: a checkerboard floor, a glass sphere and a mirror sphere under
+/// two point lights.
+pub fn builtin_scene() -> LoadedScene {
+    parse_scene(Path::new("<built-in whitted.toml>"), BUILTIN_SCENE, Path::new("."))
+        .expect("the built-in scene is valid")
+}

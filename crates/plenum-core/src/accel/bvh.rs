@@ -212,6 +212,47 @@ impl Bvh {
     }
 }
 
+impl Bvh {
+    /// Calls `visit(item)` for every item in a leaf whose box the ray crosses in (0, t_max),
+    /// until `visit` returns false. For queries that want every hit, not the nearest one.
+    pub fn for_each_candidate(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(u32) -> bool) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let inv_dir = Vec3::new(
+            1.0 / ray.direction.x,
+            1.0 / ray.direction.y,
+            1.0 / ray.direction.z,
+        );
+        let mut stack = [0u32; MAX_DEPTH];
+        let mut top = 0;
+        let mut current = 0usize;
+        loop {
+            let node = &self.nodes[current];
+            if node.bounds.intersect(ray, inv_dir, t_max).is_some() {
+                if node.count > 0 {
+                    let start = node.offset as usize;
+                    for &item in &self.order[start..start + node.count as usize] {
+                        if !visit(item) {
+                            return;
+                        }
+                    }
+                } else {
+                    stack[top] = node.offset;
+                    top += 1;
+                    current += 1;
+                    continue;
+                }
+            }
+            if top == 0 {
+                return;
+            }
+            top -= 1;
+            current = stack[top] as usize;
+        }
+    }
+}
+
 /// Moves the items satisfying `pred` to the front; returns how many there are.
 fn partition<T>(items: &mut [T], pred: impl Fn(&T) -> bool) -> usize {
     let mut first = 0;

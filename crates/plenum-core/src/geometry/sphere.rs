@@ -33,10 +33,11 @@ impl Sphere {
         // Perpendicular from the centre to the ray's line: |l|² is exact where b² − ac is not.
         let l = f + d * (half_b / a);
         let r = self.radius;
-        let discriminant = a * (r - l.length()) * (r + l.length());
+        let discriminant = a * (r * r - l.length_squared());
         if discriminant < 0.0 {
             return None;
         }
+        // c = |f|² − r², factored so that an origin near the surface keeps its digits.
         let f_len = f.length();
         let c = (f_len - r) * (f_len + r);
         let q = half_b + discriminant.sqrt().copysign(half_b);

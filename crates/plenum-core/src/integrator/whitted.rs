@@ -11,7 +11,7 @@
 use super::{MediumStack, RayKind, RayNode, RayTree, ShadowInfo, Stop};
 use crate::color::Color;
 use crate::light::Incident;
-use crate::math::{offset_ray_origin, Ray};
+use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::optics::{fresnel_dielectric, reflect, refract};
 use crate::scene::{Interaction, Scene};
 
@@ -54,8 +54,6 @@ impl RayCounts {
     }
 }
 
-/// Shadow rays give up after this many transmissive occluders (a stack of glass panes).
-const MAX_SHADOW_SEGMENTS: usize = 64;
 /// Shadow rays to a point light stop just short of it.
 const SHADOW_END: f64 = 1.0 - 1e-9;
 
@@ -65,11 +63,11 @@ pub struct Whitted<'a> {
 }
 
 /// One ray to trace, with where it sits in the tree.
-struct Branch<'t> {
+struct Branch<'t, 'm> {
     kind: RayKind,
     depth: u32,
     weight: Color,
-    media: MediumStack,
+    media: &'m MediumStack,
     tree: Option<&'t mut RayTree>,
     parent: Option<usize>,
 }
@@ -86,7 +84,7 @@ impl<'a> Whitted<'a> {
             kind: RayKind::Camera,
             depth: 0,
             weight: Color::WHITE,
-            media: MediumStack::default(),
+            media: &MediumStack::default(),
             tree,
             parent: None,
         };
@@ -143,22 +141,34 @@ impl<'a> Whitted<'a> {
             if s.is_black() {
                 continue;
             }
-            let r = reflect(-inc.wi, ns);
-            let specular = r.dot(v).max(0.0).powf(k.shininess);
-            color += s * inc.intensity * (k.diffuse * cos + k.specular * specular);
+            let mut response = k.diffuse * cos;
+            if !k.specular.is_black() {
+                let r = reflect(-inc.wi, ns);
+                response += k.specular * r.dot(v).max(0.0).powf(k.shininess);
+            }
+            color += s * inc.intensity * response;
         }
 
         // Global illumination: the reflected and refracted rays.
-        let (eta_i, eta_t, media_t) = if entering {
-            (b.media.ior(), k.ior, b.media.entered(prim, k.ior))
-        } else {
-            let outside = b.media.left(prim);
-            (k.ior, outside.ior(), outside)
-        };
         let (mut kr, mut kt) = (k.reflective, k.transmissive);
         if kr.is_black() && kt.is_black() {
             record(&mut b, node, |n| n.stops.push(Stop::Opaque));
+            record(&mut b, node, |n| n.color = color);
+            return color;
         }
+        // The medium beyond the surface, for refraction.
+        let media_t = if kt.is_black() {
+            *b.media
+        } else if entering {
+            b.media.entered(prim, k.ior)
+        } else {
+            b.media.left(prim)
+        };
+        let (eta_i, eta_t) = if entering {
+            (b.media.ior(), k.ior)
+        } else {
+            (k.ior, media_t.ior())
+        };
         if k.fresnel {
             let f = fresnel_dielectric(v.dot(n), eta_i, eta_t);
             kr = kr * f;
@@ -177,7 +187,7 @@ impl<'a> Whitted<'a> {
         };
         let secondary = [
             (RayKind::Reflected, kr, Some(reflect(d, n)), b.media),
-            (RayKind::Refracted, kt, refracted, media_t),
+            (RayKind::Refracted, kt, refracted, &media_t),
         ];
         for (kind, coefficient, direction, media) in secondary {
             let Some(direction) = direction.filter(|_| !coefficient.is_black()) else {
@@ -211,66 +221,57 @@ impl<'a> Whitted<'a> {
         color
     }
 
-    /// S_L for one light: 1, the product of the transmissive occluders' k_t, or 0.
+    /// S_L for one light: 1, the product of the transmissive occluders' k_t, or 0. Each
+    /// occluding object counts once, with k_t where the shadow ray first meets it; the
+    /// product does not depend on order, so one any-hit pass finds it, stopping at the first
+    /// opaque occluder.
     #[allow(clippy::too_many_arguments)]
     fn shadow(
         &self,
         it: &Interaction,
-        n: crate::math::Vec3,
+        n: Vec3,
         inc: &Incident,
         light: usize,
         b: &mut Branch,
         parent: Option<usize>,
         counts: &mut RayCounts,
     ) -> Color {
-        let mut origin = offset_ray_origin(it.p, it.p_error, n, inc.wi);
-        let start = origin;
-        let mut s = Color::WHITE;
-        let mut occluders = Vec::new();
+        counts.shadow += 1;
+        let origin = offset_ray_origin(it.p, it.p_error, n, inc.wi);
+        let ray = match inc.position {
+            Some(light_at) => Ray::new(origin, light_at - origin),
+            None => Ray::new(origin, inc.wi),
+        };
+        let t_max = if inc.position.is_some() { SHADOW_END } else { f64::INFINITY };
         let recording = b.tree.is_some();
-        let mut blocked = false;
-        for _ in 0..MAX_SHADOW_SEGMENTS {
-            counts.shadow += 1;
-            let (direction, t_max) = match inc.position {
-                Some(light_at) => (light_at - origin, SHADOW_END),
-                None => (inc.wi, f64::INFINITY),
-            };
-            let ray = Ray::new(origin, direction);
-            let Some((prim, hit)) = self.scene.intersect(&ray, t_max) else {
-                break;
-            };
+        let mut occluders: Vec<(f64, u32)> = Vec::new();
+        let mut s = Color::WHITE;
+        self.scene.for_each_hit(&ray, t_max, |prim, hit| {
             if recording {
-                occluders.push(self.scene.object_names[prim as usize].clone());
+                occluders.push((hit.t, prim));
             }
             let material = self.scene.material_of(prim);
-            if !material.is_transmissive() {
-                blocked = true;
-                break;
+            if material.is_transmissive() {
+                let occ = self.scene.interaction(&ray, prim, hit);
+                s *= material.transmissive.evaluate(&occ.texture);
+            } else {
+                s = Color::BLACK;
             }
-            let occ = self.scene.interaction(&ray, prim, &hit);
-            s *= material.transmissive.evaluate(&occ.texture);
-            if s.is_black() {
-                blocked = true;
-                break;
-            }
-            origin = offset_ray_origin(occ.p, occ.p_error, occ.n, direction);
-        }
-        let s = if blocked { Color::BLACK } else { s };
+            // Once black, nothing further can let light through.
+            !s.is_black() || recording
+        });
         if let Some(t) = b.tree.as_deref_mut() {
-            let mut node = RayNode::new(
-                parent,
-                RayKind::Shadow,
-                b.depth + 1,
-                start,
-                inc.wi,
-                b.weight,
-            );
+            occluders.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut node = RayNode::new(parent, RayKind::Shadow, b.depth + 1, origin, inc.wi, b.weight);
             node.distance = Some(inc.distance);
             node.color = s * inc.intensity;
             node.shadow = Some(ShadowInfo {
                 light: self.scene.light_names[light].clone(),
-                occluders,
-                blocked,
+                occluders: occluders
+                    .iter()
+                    .map(|&(_, p)| self.scene.object_names[p as usize].clone())
+                    .collect(),
+                blocked: s.is_black(),
                 transmittance: s,
             });
             t.push(node);
@@ -279,7 +280,7 @@ impl<'a> Whitted<'a> {
     }
 }
 
-fn record(b: &mut Branch, node: Option<usize>, f: impl FnOnce(&mut RayNode)) {
+fn record(b: &mut Branch<'_, '_>, node: Option<usize>, f: impl FnOnce(&mut RayNode)) {
     if let (Some(t), Some(i)) = (b.tree.as_deref_mut(), node) {
         f(&mut t.nodes[i]);
     }

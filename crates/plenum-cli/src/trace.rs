@@ -1,0 +1,128 @@
+//! `plenum trace-pixel`: the ray tree of one pixel, as text or JSON.
+
+use crate::{load, settings, TracePixelArgs};
+use plenum_core::integrator::{RayNode, RayTree};
+use plenum_core::render::trace_pixel;
+use plenum_core::{Color, Vec3};
+use serde_json::{json, Value};
+use std::process::ExitCode;
+
+pub fn run(args: TracePixelArgs) -> ExitCode {
+    let loaded = match load(Some(&args.scene)) {
+        Ok(l) => l,
+        Err(code) => return code,
+    };
+    let settings = match settings(&args.view, &loaded) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    if args.x >= settings.width || args.y >= settings.height {
+        eprintln!(
+            "error: pixel ({}, {}) is outside the {}×{} image",
+            args.x, args.y, settings.width, settings.height
+        );
+        return ExitCode::from(2);
+    }
+    let (tree, color) = trace_pixel(&loaded.scene, &settings, args.x, args.y);
+    if args.json {
+        let doc = json!({
+            "pixel": [args.x, args.y],
+            "color": rgb(color),
+            "rays": tree.nodes.iter().enumerate().map(|(i, n)| node_json(i, n)).collect::<Vec<_>>(),
+        });
+        println!("{}", serde_json::to_string_pretty(&doc).unwrap_or_default());
+    } else {
+        println!("pixel ({}, {}): colour {}", args.x, args.y, fmt_color(color));
+        for root in (0..tree.nodes.len()).filter(|&i| tree.nodes[i].parent.is_none()) {
+            print_node(&tree, root, 0);
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+fn rgb(c: Color) -> Value {
+    json!([c.r, c.g, c.b])
+}
+
+fn xyz(v: Vec3) -> Value {
+    json!([v.x, v.y, v.z])
+}
+
+fn node_json(id: usize, n: &RayNode) -> Value {
+    let mut v = json!({
+        "id": id,
+        "parent": n.parent,
+        "kind": n.kind.name(),
+        "depth": n.depth,
+        "origin": xyz(n.origin),
+        "direction": xyz(n.direction),
+        "weight": rgb(n.weight),
+        "object": n.object,
+        "material": n.material,
+        "distance": n.distance,
+        "color": rgb(n.color),
+        "stopped": n.stops.iter().map(|s| s.name()).collect::<Vec<_>>(),
+        "total_internal_reflection": n.total_internal_reflection,
+    });
+    if let Some(s) = &n.shadow {
+        v["light"] = json!(s.light);
+        v["blocked"] = json!(s.blocked);
+        v["occluders"] = json!(s.occluders);
+        v["transmittance"] = rgb(s.transmittance);
+    }
+    v
+}
+
+fn fmt_color(c: Color) -> String {
+    format!("({:.4}, {:.4}, {:.4})", c.r, c.g, c.b)
+}
+
+fn fmt_vec(v: Vec3) -> String {
+    format!("({:.4}, {:.4}, {:.4})", v.x, v.y, v.z)
+}
+
+fn print_node(tree: &RayTree, id: usize, indent: usize) {
+    let n = &tree.nodes[id];
+    let pad = "  ".repeat(indent);
+    let head = format!(
+        "{pad}{} ray (depth {}, weight {}) from {} along {}",
+        n.kind.name(),
+        n.depth,
+        fmt_color(n.weight),
+        fmt_vec(n.origin),
+        fmt_vec(n.direction)
+    );
+    println!("{head}");
+    if let Some(s) = &n.shadow {
+        let status = if s.blocked {
+            format!("blocked by {}", s.occluders.join(", then "))
+        } else if s.occluders.is_empty() {
+            "unblocked".to_string()
+        } else {
+            format!("through {}", s.occluders.join(", then "))
+        };
+        println!(
+            "{pad}  to light \"{}\" at distance {:.4}: {status}; S_L = {}",
+            s.light,
+            n.distance.unwrap_or(f64::INFINITY),
+            fmt_color(s.transmittance)
+        );
+        return;
+    }
+    if let (Some(object), Some(material)) = (&n.object, &n.material) {
+        println!(
+            "{pad}  hit \"{object}\" (material \"{material}\") at distance {:.4}",
+            n.distance.unwrap_or(0.0)
+        );
+    }
+    if n.total_internal_reflection {
+        println!("{pad}  total internal reflection: the refracted weight goes to the reflected ray");
+    }
+    for stop in &n.stops {
+        println!("{pad}  stopped: {}", stop.name());
+    }
+    println!("{pad}  returned {}", fmt_color(n.color));
+    for child in tree.children(id) {
+        print_node(tree, child, indent + 1);
+    }
+}

@@ -1,0 +1,562 @@
+//! Plenum's native scene format: TOML, documented field by field in docs/scene-format.md.
+
+use crate::diagnostics::{did_you_mean, SceneError};
+use crate::reader::{Fields, Result, Source, Value};
+use crate::{obj, RenderDefaults};
+use plenum_core::camera::CameraSettings;
+use plenum_core::color::Color;
+use plenum_core::geometry::{
+    Cone, Cuboid, Cylinder, Disk, Plane, Polygon, Polyhedron, Shape, Sphere, TriangleMesh,
+};
+use plenum_core::light::{Attenuation, Light};
+use plenum_core::material::Material;
+use plenum_core::math::{Matrix4, Transform, Vec3};
+use plenum_core::scene::{MaterialId, SceneBuilder};
+use plenum_core::texture::{ImageTexture, Texture};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use toml::de::{DeTable, DeValue};
+
+const TOP_LEVEL: &[&str] = &["background", "render", "camera", "materials", "meshes", "lights", "objects"];
+const COMMON: [&str; 4] = ["type", "name", "material", "transform"];
+
+/// Parses a native scene. `base_dir` resolves relative paths (meshes, textures).
+pub fn parse(path: &Path, text: &str, base_dir: &Path) -> Result<(SceneBuilder, RenderDefaults)> {
+    let doc = DeTable::parse(text).map_err(|e| {
+        let span = e.span().unwrap_or(0..0);
+        SceneError::at(path, text, span, e.message().trim().to_string())
+    })?;
+    let src = Source { path, text };
+    let top = Fields::new(src, doc.get_ref(), doc.span(), "the scene", TOP_LEVEL)?;
+    let mut reader = Reader {
+        src,
+        base_dir: base_dir.to_path_buf(),
+        builder: SceneBuilder::default(),
+        materials: HashMap::new(),
+        meshes: HashMap::new(),
+    };
+    if let Some(v) = top.get("background") {
+        reader.builder.background = reader.color(v)?;
+    }
+    let mut defaults = RenderDefaults::default();
+    if let Some(v) = top.get("render") {
+        reader.render(v, &mut defaults)?;
+    }
+    if let Some(v) = top.get("camera") {
+        reader.camera(v, &mut defaults)?;
+    }
+    if let Some(v) = top.get("materials") {
+        let DeValue::Table(t) = v.get_ref() else {
+            return Err(src.error(v.span(), "expected a table of named materials: [materials.NAME]"));
+        };
+        for (name, value) in t.iter() {
+            reader.material(name.get_ref(), value)?;
+        }
+    }
+    if let Some(v) = top.get("meshes") {
+        let DeValue::Table(t) = v.get_ref() else {
+            return Err(src.error(v.span(), "expected a table of named meshes: [meshes.NAME]"));
+        };
+        for (name, value) in t.iter() {
+            let f = src.table(value, &format!("mesh `{}`", name.get_ref()), &["file", "positions", "indices", "normals", "uvs"])?;
+            let mesh = reader.mesh_data(&f)?;
+            reader.meshes.insert(name.get_ref().to_string(), mesh);
+        }
+    }
+    if let Some(v) = top.get("lights") {
+        for (i, light) in src.array(v, "an array of lights: [[lights]]")?.iter().enumerate() {
+            reader.light(i, light)?;
+        }
+    }
+    if let Some(v) = top.get("objects") {
+        for (i, object) in src.array(v, "an array of objects: [[objects]]")?.iter().enumerate() {
+            reader.object(i, object)?;
+        }
+    }
+    Ok((reader.builder, defaults))
+}
+
+struct Reader<'s> {
+    src: Source<'s>,
+    base_dir: PathBuf,
+    builder: SceneBuilder,
+    materials: HashMap<String, MaterialId>,
+    meshes: HashMap<String, Arc<TriangleMesh>>,
+}
+
+impl<'s> Reader<'s> {
+    fn render(&mut self, v: &Value<'s>, d: &mut RenderDefaults) -> Result<()> {
+        let f = self.src.table(v, "[render]", &["spp", "max_depth", "min_weight", "exposure"])?;
+        if let Some(spp) = f.count("spp")? {
+            d.spp = spp.max(1);
+        }
+        if let Some(depth) = f.count("max_depth")? {
+            d.max_depth = depth;
+        }
+        d.min_weight = f.number_or("min_weight", d.min_weight)?;
+        d.exposure = f.number_or("exposure", d.exposure)?;
+        Ok(())
+    }
+
+    fn camera(&mut self, v: &Value<'s>, d: &mut RenderDefaults) -> Result<()> {
+        let f = self.src.table(v, "[camera]", &["position", "look_at", "up", "fov", "resolution"])?;
+        let c = CameraSettings::default();
+        let position = f.vec3_or("position", c.position)?;
+        let look_at = f.vec3_or("look_at", c.look_at)?;
+        if (look_at - position).length_squared() == 0.0 {
+            let span = f.get("look_at").or(f.get("position")).map_or(f.span.clone(), |v| v.span());
+            return Err(self.src.error(span, "the camera looks at its own position: expected look_at ≠ position"));
+        }
+        let up = f.direction("up", Some(c.up))?;
+        if up.cross(look_at - position).length_squared() == 0.0 {
+            let span = f.get("up").map_or(f.span.clone(), |v| v.span());
+            return Err(self.src.error(span, "`up` is parallel to the viewing direction"));
+        }
+        let fov = f.number_or("fov", c.fov_degrees)?;
+        if !(fov > 0.0 && fov < 180.0) {
+            return Err(self.src.error(f.get("fov").map_or(f.span.clone(), |v| v.span()), format!("expected a field of view between 0 and 180 degrees, found {fov}")));
+        }
+        if let Some(r) = f.get("resolution") {
+            let [w, h] = self.src.numbers::<2>(r, "[width, height] in pixels")?;
+            if w < 1.0 || h < 1.0 || w.fract() != 0.0 || h.fract() != 0.0 {
+                return Err(self.src.error(r.span(), "expected a resolution of whole pixels ≥ 1"));
+            }
+            d.width = w as u32;
+            d.height = h as u32;
+        }
+        self.builder.camera = CameraSettings {
+            position,
+            look_at,
+            up,
+            fov_degrees: fov,
+        };
+        Ok(())
+    }
+
+    /// A colour: `[r, g, b]`, a grey level, or a texture table.
+    fn color(&self, v: &Value<'s>) -> Result<Color> {
+        match v.get_ref() {
+            DeValue::Integer(_) | DeValue::Float(_) => {
+                let g = self.src.number(v)?;
+                self.non_negative(v, Color::gray(g))
+            }
+            _ => {
+                let c = self.src.numbers::<3>(v, "a colour: [r, g, b] or a number")?;
+                self.non_negative(v, Color::new(c[0], c[1], c[2]))
+            }
+        }
+    }
+
+    fn non_negative(&self, v: &Value<'s>, c: Color) -> Result<Color> {
+        if c.r < 0.0 || c.g < 0.0 || c.b < 0.0 {
+            Err(self.src.error(v.span(), "expected colour components ≥ 0"))
+        } else {
+            Ok(c)
+        }
+    }
+
+    fn texture(&self, v: &Value<'s>) -> Result<Texture> {
+        let DeValue::Table(_) = v.get_ref() else {
+            return Ok(Texture::Constant(self.color(v)?));
+        };
+        let kind = {
+            let f = self.src.table(v, "a texture", &["texture", "even", "odd", "scale", "file"])?;
+            let k = f.required("texture")?;
+            (self.src.string(k)?.to_string(), k.span())
+        };
+        match kind.0.as_str() {
+            "checker" | "checker3d" => {
+                let f = self.src.table(v, "a checker texture", &["texture", "even", "odd", "scale"])?;
+                let even = f.get("even").map_or(Ok(Color::WHITE), |c| self.color(c))?;
+                let odd = f.get("odd").map_or(Ok(Color::BLACK), |c| self.color(c))?;
+                let scale = f.positive("scale", Some(1.0))?;
+                Ok(if kind.0 == "checker" {
+                    Texture::Checker2d { even, odd, scale }
+                } else {
+                    Texture::Checker3d { even, odd, scale }
+                })
+            }
+            "image" => {
+                let f = self.src.table(v, "an image texture", &["texture", "file", "scale"])?;
+                let file = f.required("file")?;
+                let path = self.base_dir.join(self.src.string(file)?);
+                let texels = plenum_image::read_texture(&path)
+                    .map_err(|e| self.src.error(file.span(), e.to_string()))?;
+                let scale = match f.get("scale") {
+                    None => [1.0, 1.0],
+                    Some(s) => self.src.numbers::<2>(s, "[u, v] repeats")?,
+                };
+                let (width, height) = (texels.width, texels.height);
+                let texels = texels.rgb.iter().map(|p| Color::new(p[0] as f64, p[1] as f64, p[2] as f64)).collect();
+                let image = ImageTexture::new(width, height, texels, scale)
+                    .ok_or_else(|| self.src.error(file.span(), "the image is empty"))?;
+                Ok(Texture::Image(Arc::new(image)))
+            }
+            other => {
+                let e = self.src.error(kind.1, format!("unknown texture `{other}`"));
+                Err(match did_you_mean(other, ["checker", "checker3d", "image"]) {
+                    Some(s) => e.with_help(format!("did you mean `{s}`?")),
+                    None => e.with_help("expected one of: checker, checker3d, image"),
+                })
+            }
+        }
+    }
+
+    fn material(&mut self, name: &str, v: &Value<'s>) -> Result<()> {
+        const FIELDS: &[&str] = &["emissive", "ambient", "diffuse", "specular", "shininess", "reflective", "transmissive", "ior", "fresnel"];
+        let f = self.src.table(v, &format!("material `{name}`"), FIELDS)?;
+        let d = Material::default();
+        let tex = |key: &str, default: Texture| f.get(key).map_or(Ok(default), |v| self.texture(v));
+        let fresnel = f.bool_or("fresnel", d.fresnel)?;
+        // With Fresnel weighting, k_r is a tint: white unless given.
+        let reflective_default = if fresnel { Color::WHITE } else { Color::BLACK };
+        let m = Material {
+            emissive: tex("emissive", d.emissive.clone())?,
+            ambient: tex("ambient", d.ambient.clone())?,
+            diffuse: tex("diffuse", d.diffuse.clone())?,
+            specular: tex("specular", d.specular.clone())?,
+            shininess: match f.get("shininess") {
+                None => d.shininess,
+                Some(s) => {
+                    let n = self.src.number(s)?;
+                    if n < 0.0 {
+                        return Err(self.src.error(s.span(), format!("expected a shininess ≥ 0, found {n}")));
+                    }
+                    n
+                }
+            },
+            reflective: tex("reflective", Texture::Constant(reflective_default))?,
+            transmissive: tex("transmissive", d.transmissive.clone())?,
+            ior: f.positive("ior", Some(1.0))?,
+            fresnel,
+        };
+        let id = self.builder.add_material(name, m);
+        self.materials.insert(name.to_string(), id);
+        Ok(())
+    }
+
+    fn light(&mut self, index: usize, v: &Value<'s>) -> Result<()> {
+        let kind = self.kind(v, "a light", &["point", "directional", "spot", "ambient"])?;
+        let what = format!("{kind} light");
+        let name_of = |f: &Fields| -> Result<String> {
+            Ok(f.string("name")?.map_or_else(|| format!("{kind} light {}", index + 1), str::to_string))
+        };
+        let intensity = |f: &Fields| -> Result<Color> {
+            let c = f.get("color").map_or(Ok(Color::WHITE), |c| self.color(c))?;
+            Ok(c * f.number_or("intensity", 1.0)?)
+        };
+        match kind.as_str() {
+            "point" => {
+                let f = self.src.table(v, &what, &["type", "name", "position", "color", "intensity", "attenuation"])?;
+                let light = Light::Point {
+                    position: f.required_vec3("position")?,
+                    intensity: intensity(&f)?,
+                    attenuation: self.attenuation(&f)?,
+                };
+                self.builder.add_light(name_of(&f)?, light);
+            }
+            "directional" => {
+                let f = self.src.table(v, &what, &["type", "name", "direction", "color", "intensity"])?;
+                let light = Light::Directional {
+                    direction: f.direction("direction", None)?.normalized(),
+                    intensity: intensity(&f)?,
+                };
+                self.builder.add_light(name_of(&f)?, light);
+            }
+            "spot" => {
+                let f = self.src.table(v, &what, &["type", "name", "position", "direction", "inner_angle", "outer_angle", "color", "intensity", "attenuation"])?;
+                let outer = f.positive("outer_angle", Some(30.0))?;
+                let inner = f.number_or("inner_angle", outer.min(20.0))?;
+                if !(0.0..=outer).contains(&inner) || outer > 180.0 {
+                    let span = f.get("inner_angle").or(f.get("outer_angle")).map_or(f.span.clone(), |v| v.span());
+                    return Err(self.src.error(span, format!("expected 0 ≤ inner_angle ≤ outer_angle ≤ 180 degrees, found {inner} and {outer}")));
+                }
+                let light = Light::Spot {
+                    position: f.required_vec3("position")?,
+                    direction: f.direction("direction", None)?.normalized(),
+                    cos_inner: inner.to_radians().cos(),
+                    cos_outer: outer.to_radians().cos(),
+                    intensity: intensity(&f)?,
+                    attenuation: self.attenuation(&f)?,
+                };
+                self.builder.add_light(name_of(&f)?, light);
+            }
+            _ => {
+                let f = self.src.table(v, &what, &["type", "name", "color", "intensity"])?;
+                self.builder.ambient += intensity(&f)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn attenuation(&self, f: &Fields<'_, 's>) -> Result<Attenuation> {
+        let Some(v) = f.get("attenuation") else {
+            return Ok(Attenuation::default());
+        };
+        let [a, b, c] = self.src.numbers::<3>(v, "[constant, linear, quadratic] coefficients")?;
+        if a < 0.0 || b < 0.0 || c < 0.0 || a + b + c == 0.0 {
+            return Err(self.src.error(v.span(), "expected attenuation coefficients ≥ 0, not all zero"));
+        }
+        Ok(Attenuation {
+            constant: a,
+            linear: b,
+            quadratic: c,
+        })
+    }
+
+    /// The `type` of a light or object, checked against the known kinds.
+    fn kind(&self, v: &Value<'s>, what: &str, kinds: &[&'static str]) -> Result<String> {
+        let DeValue::Table(t) = v.get_ref() else {
+            return Err(self.src.error(v.span(), format!("expected a table for {what}")));
+        };
+        let Some(k) = t.get("type") else {
+            let start = v.span().start;
+            let end = self.src.text[start..].find('\n').map_or(self.src.text.len(), |i| start + i);
+            return Err(self.src.error(start..end, format!("missing field `type` in {what}")).with_help(format!("expected one of: {}", kinds.join(", "))));
+        };
+        let kind = self.src.string(k)?;
+        if kinds.contains(&kind) {
+            return Ok(kind.to_string());
+        }
+        let e = self.src.error(k.span(), format!("unknown type `{kind}` for {what}"));
+        Err(match did_you_mean(kind, kinds.iter().copied()) {
+            Some(s) => e.with_help(format!("did you mean `{s}`?")),
+            None => e.with_help(format!("expected one of: {}", kinds.join(", "))),
+        })
+    }
+
+    fn object(&mut self, index: usize, v: &Value<'s>) -> Result<()> {
+        const KINDS: &[&str] = &["sphere", "plane", "disk", "box", "cylinder", "cone", "polygon", "polyhedron", "mesh"];
+        let kind = self.kind(v, "an object", KINDS)?;
+        let fields: &[&'static str] = match kind.as_str() {
+            "sphere" => &["center", "radius"],
+            "plane" => &["point", "normal"],
+            "disk" => &["center", "normal", "radius"],
+            "box" => &["min", "max"],
+            "cylinder" => &["base", "top", "radius", "capped"],
+            "cone" => &["base", "top", "radius", "top_radius", "capped"],
+            "polygon" => &["vertices"],
+            "polyhedron" => &["vertices", "faces"],
+            _ => &["mesh", "file", "positions", "indices", "normals", "uvs"],
+        };
+        let allowed: Vec<&'static str> = COMMON.iter().chain(fields).copied().collect();
+        let f = self.src.table(v, &kind, &allowed)?;
+        let (shape, frame) = self.shape(&kind, &f)?;
+        let placement = match f.get("transform") {
+            Some(t) => self.transform(t)?,
+            None => Transform::IDENTITY,
+        };
+        let material = self.material_ref(&f)?;
+        let name = f.string("name")?.map_or_else(|| format!("{kind} {}", index + 1), str::to_string);
+        self.builder.add_object(name, shape, placement.after(&frame), material);
+        Ok(())
+    }
+
+    fn material_ref(&mut self, f: &Fields<'_, 's>) -> Result<MaterialId> {
+        let Some(v) = f.get("material") else {
+            if let Some(&id) = self.materials.get("default") {
+                return Ok(id);
+            }
+            let id = self.builder.add_material("default", Material::default());
+            self.materials.insert("default".into(), id);
+            return Ok(id);
+        };
+        let name = self.src.string(v)?;
+        if let Some(&id) = self.materials.get(name) {
+            return Ok(id);
+        }
+        let e = self.src.error(v.span(), format!("no material named `{name}` is defined"));
+        let mut known: Vec<&str> = self.materials.keys().map(String::as_str).collect();
+        known.sort();
+        Err(match did_you_mean(name, known.iter().copied()) {
+            Some(s) => e.with_help(format!("did you mean `{s}`?")),
+            None if known.is_empty() => e.with_help("define it in a [materials.NAME] table"),
+            None => e.with_help(format!("defined materials: {}", known.join(", "))),
+        })
+    }
+
+    /// The shape in its own coordinates and the frame that places it (identity for most).
+    fn shape(&mut self, kind: &str, f: &Fields<'_, 's>) -> Result<(Shape, Transform)> {
+        let src = self.src;
+        let shape = match kind {
+            "sphere" => Shape::Sphere(Sphere::new(f.vec3_or("center", Vec3::ZERO)?, f.positive("radius", None)?)),
+            "plane" => Shape::Plane(Plane::new(f.vec3_or("point", Vec3::ZERO)?, f.direction("normal", None)?)),
+            "disk" => Shape::Disk(Disk::new(f.vec3_or("center", Vec3::ZERO)?, f.direction("normal", None)?, f.positive("radius", None)?)),
+            "box" => {
+                let (min, max) = (f.required_vec3("min")?, f.required_vec3("max")?);
+                if min.x >= max.x || min.y >= max.y || min.z >= max.z {
+                    return Err(src.error(f.required("max")?.span(), "expected max greater than min on every axis"));
+                }
+                Shape::Cuboid(Cuboid::new(min, max))
+            }
+            "cylinder" | "cone" => {
+                let base = f.vec3_or("base", Vec3::ZERO)?;
+                let top = f.vec3_or("top", Vec3::Y)?;
+                let axis = top - base;
+                let height = axis.length();
+                if height == 0.0 {
+                    let span = f.get("top").map_or(f.span.clone(), |v| v.span());
+                    return Err(src.error(span, "expected `top` to differ from `base`"));
+                }
+                let z = axis / height;
+                let (x, y) = z.orthonormal_basis();
+                let frame = Transform::frame(base, x, y, z).unwrap_or_default();
+                let radius = f.positive("radius", None)?;
+                let capped = f.bool_or("capped", true)?;
+                let shape = if kind == "cylinder" {
+                    Shape::Cylinder(Cylinder::new(radius, height, capped))
+                } else {
+                    let top_radius = f.number_or("top_radius", 0.0)?;
+                    if top_radius < 0.0 {
+                        return Err(src.error(f.required("top_radius")?.span(), format!("expected a top_radius ≥ 0, found {top_radius}")));
+                    }
+                    Shape::Cone(Cone { radius0: radius, radius1: top_radius, height, capped })
+                };
+                return Ok((shape, frame));
+            }
+            "polygon" => {
+                let v = f.required("vertices")?;
+                let vertices = self.points(v)?;
+                Shape::Polygon(Box::new(Polygon::new(vertices).map_err(|e| src.error(v.span(), e.to_string()))?))
+            }
+            "polyhedron" => {
+                let vs = f.required("vertices")?;
+                let vertices = self.points(vs)?;
+                let fv = f.required("faces")?;
+                let mut faces = Vec::new();
+                for face in src.array(fv, "an array of faces, each an array of vertex indices")? {
+                    let mut loop_ = Vec::new();
+                    for i in src.array(face, "a face: an array of vertex indices")? {
+                        let index = src.index(i)?;
+                        if index as usize >= vertices.len() {
+                            return Err(src.error(i.span(), format!("vertex index {index} is out of range: there are {} vertices", vertices.len())));
+                        }
+                        loop_.push(index);
+                    }
+                    faces.push(loop_);
+                }
+                Shape::Polyhedron(Box::new(Polyhedron::new(&vertices, &faces).map_err(|e| src.error(fv.span(), e.to_string()))?))
+            }
+            _ => {
+                if let Some(m) = f.get("mesh") {
+                    let name = src.string(m)?;
+                    let Some(mesh) = self.meshes.get(name) else {
+                        let e = src.error(m.span(), format!("no mesh named `{name}` is defined"));
+                        return Err(match did_you_mean(name, self.meshes.keys().map(String::as_str)) {
+                            Some(s) => e.with_help(format!("did you mean `{s}`?")),
+                            None => e.with_help("define it in a [meshes.NAME] table"),
+                        });
+                    };
+                    Shape::Mesh(mesh.clone())
+                } else {
+                    Shape::Mesh(self.mesh_data(f)?)
+                }
+            }
+        };
+        Ok((shape, Transform::IDENTITY))
+    }
+
+    fn points(&self, v: &Value<'s>) -> Result<Vec<Vec3>> {
+        self.src
+            .array(v, "an array of points [[x, y, z], …]")?
+            .iter()
+            .map(|p| self.src.vec3(p))
+            .collect()
+    }
+
+    /// A mesh from `file` (OBJ) or from inline `positions` and `indices`.
+    fn mesh_data(&self, f: &Fields<'_, 's>) -> Result<Arc<TriangleMesh>> {
+        let src = self.src;
+        if let Some(file) = f.get("file") {
+            let rel = src.string(file)?;
+            let path = self.base_dir.join(rel);
+            let text = std::fs::read_to_string(&path).map_err(|e| {
+                src.error(file.span(), format!("cannot read mesh file `{}`: {e}", path.display()))
+            })?;
+            let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+            if !is_obj {
+                return Err(src.error(file.span(), "expected an OBJ mesh file (.obj)"));
+            }
+            return obj::parse_obj(&path, &text).map(Arc::new);
+        }
+        let pv = f.required("positions")?;
+        let positions = self.points(pv)?;
+        let iv = f.required("indices")?;
+        let mut triangles = Vec::new();
+        for tri in src.array(iv, "an array of triangles [[i, j, k], …]")? {
+            let items = src.array(tri, "a triangle: [i, j, k]")?;
+            if items.len() != 3 {
+                return Err(src.error(tri.span(), format!("expected a triangle of 3 indices, found {}", items.len())));
+            }
+            let mut t = [0u32; 3];
+            for (slot, i) in t.iter_mut().zip(items) {
+                *slot = src.index(i)?;
+                if *slot as usize >= positions.len() {
+                    return Err(src.error(i.span(), format!("vertex index {} is out of range: there are {} positions", slot, positions.len())));
+                }
+            }
+            triangles.push(t);
+        }
+        let normals = match f.get("normals") {
+            Some(n) => self.points(n)?,
+            None => Vec::new(),
+        };
+        let uvs = match f.get("uvs") {
+            Some(u) => src
+                .array(u, "an array of [u, v] pairs")?
+                .iter()
+                .map(|p| src.numbers::<2>(p, "a texture coordinate [u, v]"))
+                .collect::<Result<Vec<_>>>()?,
+            None => Vec::new(),
+        };
+        TriangleMesh::new(positions, triangles, normals, uvs)
+            .map(Arc::new)
+            .map_err(|e| src.error(pv.span(), e.to_string()))
+    }
+
+    /// A list of transform steps, the first applied first.
+    fn transform(&self, v: &Value<'s>) -> Result<Transform> {
+        let src = self.src;
+        let steps: Vec<&Value<'s>> = match v.get_ref() {
+            DeValue::Table(_) => vec![v],
+            _ => src.array(v, "a list of transforms [{ translate = … }, …]")?.iter().collect(),
+        };
+        let mut total = Transform::IDENTITY;
+        for step in steps {
+            let f = src.table(step, "a transform step", &["translate", "rotate", "scale", "matrix"])?;
+            let (key, value) = match ["translate", "rotate", "scale", "matrix"].iter().filter_map(|k| f.get(k).map(|v| (*k, v))).collect::<Vec<_>>()[..] {
+                [one] => one,
+                _ => return Err(src.error(step.span(), "expected exactly one of translate, rotate, scale or matrix in each transform step")),
+            };
+            let t = match key {
+                "translate" => Some(Transform::translate(src.vec3(value)?)),
+                "rotate" => {
+                    let r = src.table(value, "a rotation", &["axis", "degrees"])?;
+                    Transform::rotate(r.direction("axis", None)?, r.src.number(r.required("degrees")?)?)
+                }
+                "scale" => {
+                    let s = match value.get_ref() {
+                        DeValue::Array(_) => src.vec3(value)?,
+                        _ => Vec3::splat(src.number(value)?),
+                    };
+                    Transform::scale(s)
+                }
+                _ => {
+                    let rows = src.array(value, "a 4×4 matrix: 4 rows of 4 numbers")?;
+                    if rows.len() != 4 {
+                        return Err(src.error(value.span(), "expected a 4×4 matrix: 4 rows of 4 numbers"));
+                    }
+                    let mut m = [[0.0; 4]; 4];
+                    for (row, r) in m.iter_mut().zip(rows) {
+                        *row = src.numbers::<4>(r, "a matrix row of 4 numbers")?;
+                    }
+                    Transform::from_matrix(Matrix4(m))
+                }
+            };
+            let t = t.ok_or_else(|| src.error(value.span(), format!("this {key} is singular or not affine: it cannot be inverted")))?;
+            total = t.after(&total);
+        }
+        Ok(total)
+    }
+}

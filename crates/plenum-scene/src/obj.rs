@@ -1,0 +1,149 @@
+//! Wavefront OBJ geometry: `v`, `vt`, `vn` and `f` records (polygons fanned into triangles,
+//! negative indices counted from the end). Groups, smoothing groups and materials are read
+//! past; the native format assigns the material.
+
+use crate::diagnostics::SceneError;
+use plenum_core::geometry::TriangleMesh;
+use plenum_core::math::Vec3;
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Parses OBJ text; errors are located in `path`.
+pub fn parse_obj(path: &Path, text: &str) -> Result<TriangleMesh, SceneError> {
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    let mut uvs = Vec::new();
+    // OBJ indexes position, uv and normal separately; a mesh vertex is one distinct triple.
+    let mut vertex_of: HashMap<(u32, u32, u32), u32> = HashMap::new();
+    let mut out_positions = Vec::new();
+    let mut out_normals = Vec::new();
+    let mut out_uvs = Vec::new();
+    let mut triangles = Vec::new();
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        let start = offset;
+        offset += line.len();
+        let content = line.split('#').next().unwrap_or("");
+        let mut tokens = tokens_with_offsets(content, start);
+        let Some((keyword, _)) = tokens.next() else {
+            continue;
+        };
+        let err = |span: (usize, usize), msg: String| SceneError::at(path, text, span.0..span.1, msg);
+        let mut numbers = |n: usize, what: &str| -> Result<Vec<f64>, SceneError> {
+            let mut out = Vec::with_capacity(n);
+            for _ in 0..n {
+                let Some((tok, span)) = tokens.next() else {
+                    return Err(err((start, start + content.trim_end().len()), format!("expected {n} numbers for {what}")));
+                };
+                match tok.parse::<f64>() {
+                    Ok(v) if v.is_finite() => out.push(v),
+                    _ => return Err(err(span, format!("expected a finite number, found `{tok}`"))),
+                }
+            }
+            Ok(out)
+        };
+        match keyword {
+            "v" => {
+                let v = numbers(3, "a vertex position")?;
+                positions.push(Vec3::new(v[0], v[1], v[2]));
+            }
+            "vn" => {
+                let v = numbers(3, "a vertex normal")?;
+                normals.push(Vec3::new(v[0], v[1], v[2]));
+            }
+            "vt" => {
+                let v = numbers(2, "a texture coordinate")?;
+                uvs.push([v[0], v[1]]);
+            }
+            "f" => {
+                let mut corners = Vec::new();
+                for (tok, span) in tokens.by_ref() {
+                    let mut parts = tok.split('/');
+                    let resolve = |s: Option<&str>, count: usize, what: &str| -> Result<u32, SceneError> {
+                        match s {
+                            None | Some("") => Ok(u32::MAX),
+                            Some(s) => {
+                                let i: i64 = s.parse().map_err(|_| err(span, format!("expected a {what} index, found `{s}`")))?;
+                                let resolved = if i < 0 { count as i64 + i } else { i - 1 };
+                                if i == 0 || resolved < 0 || resolved >= count as i64 {
+                                    return Err(err(span, format!("{what} index {i} is out of range: there are {count} so far")));
+                                }
+                                Ok(resolved as u32)
+                            }
+                        }
+                    };
+                    let p = resolve(parts.next(), positions.len(), "vertex")?;
+                    if p == u32::MAX {
+                        return Err(err(span, "a face corner needs a vertex index".into()));
+                    }
+                    let t = resolve(parts.next(), uvs.len(), "texture coordinate")?;
+                    let n = resolve(parts.next(), normals.len(), "normal")?;
+                    let key = (p, t, n);
+                    let index = *vertex_of.entry(key).or_insert_with(|| {
+                        out_positions.push(positions[p as usize]);
+                        out_normals.push(if n == u32::MAX { Vec3::ZERO } else { normals[n as usize] });
+                        out_uvs.push(if t == u32::MAX { [0.0, 0.0] } else { uvs[t as usize] });
+                        (out_positions.len() - 1) as u32
+                    });
+                    corners.push(index);
+                }
+                if corners.len() < 3 {
+                    return Err(err((start, start + content.trim_end().len()), format!("a face needs at least 3 corners, found {}", corners.len())));
+                }
+                for i in 1..corners.len() - 1 {
+                    triangles.push([corners[0], corners[i], corners[i + 1]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    // Shading normals only when every vertex has one.
+    if normals.is_empty() || out_normals.iter().any(|n| n.length_squared() == 0.0) {
+        out_normals.clear();
+    }
+    if uvs.is_empty() {
+        out_uvs.clear();
+    }
+    TriangleMesh::new(out_positions, triangles, out_normals, out_uvs)
+        .map_err(|e| SceneError::file(path, e.to_string()))
+}
+
+/// Whitespace-separated tokens with their byte spans in the whole text.
+fn tokens_with_offsets(line: &str, base: usize) -> impl Iterator<Item = (&str, (usize, usize))> {
+    let mut rest = line;
+    let mut pos = base;
+    std::iter::from_fn(move || {
+        let trimmed = rest.trim_start();
+        pos += rest.len() - trimmed.len();
+        if trimmed.is_empty() {
+            return None;
+        }
+        let end = trimmed.find(char::is_whitespace).unwrap_or(trimmed.len());
+        let tok = &trimmed[..end];
+        let span = (pos, pos + end);
+        pos += end;
+        rest = &trimmed[end..];
+        Some((tok, span))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quad_with_negative_indices_and_normals() {
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf -4//1 -3//1 -2//1 -1//1\n";
+        let mesh = parse_obj(Path::new("q.obj"), text).unwrap();
+        assert_eq!(mesh.triangle_count(), 2);
+    }
+
+    #[test]
+    fn errors_are_located() {
+        let e = parse_obj(Path::new("bad.obj"), "v 0 0 0\nv 1 nan 0\n").unwrap_err();
+        assert_eq!((e.line, e.column), (2, 5));
+        let e = parse_obj(Path::new("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap_err();
+        assert_eq!((e.line, e.column), (4, 7));
+        assert!(e.message.contains("out of range"), "{}", e.message);
+    }
+}
