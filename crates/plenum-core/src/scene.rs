@@ -7,7 +7,7 @@ use crate::color::Color;
 use crate::geometry::{HitRecord, Shape};
 use crate::light::Light;
 use crate::material::Material;
-use crate::math::{Bounds3, Ray, Transform, Vec3};
+use crate::math::{gamma, Bounds3, Ray, Transform, Vec3};
 use crate::texture::TextureCoords;
 
 /// Index of a material in [`Scene::materials`].
@@ -72,10 +72,23 @@ impl Primitive {
                 };
                 let g = self.shape.surface(&local, &local_hit);
                 let (p, p_error) = t.point_with_error(g.p, g.p_error);
+                // A spawned ray is intersected in object space, where what keeps it off the
+                // surface is its distance along the object normal. Offsetting by the world
+                // error box alone falls short under anisotropic scales: require the world
+                // offset to map to more than the object-space error along the normal (that of
+                // the hit, that of taking the new origin back into object space, and that of
+                // the stored inverse itself).
+                let normal = t.normal(g.n);
+                let stretch = normal.length();
+                let n = normal / stretch;
+                let inverse_mismatch = t.inverse_residual() * (g.p.abs().max_component() + 1.0);
+                let object_error = g.n.abs().dot(g.p_error + t.inverse_error(p))
+                    + inverse_mismatch * g.n.abs().dot(Vec3::ONE);
+                let p_error = p_error + n.abs() * (object_error / stretch * (1.0 + gamma(4)));
                 Interaction {
                     p,
                     p_error,
-                    n: t.normal(g.n).normalized(),
+                    n,
                     shading_n: t.normal(g.shading_n).normalized(),
                     texture: TextureCoords {
                         uv: g.uv,

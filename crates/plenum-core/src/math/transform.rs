@@ -213,6 +213,33 @@ impl Transform {
         (self.point(p), Vec3::new(row(&m[0]), row(&m[1]), row(&m[2])))
     }
 
+    /// How far the stored inverse is from the true one: the largest entry of
+    /// |M⁻¹·M − I|, doubled to cover the rounding of the check itself. An inverse computed in
+    /// floating point is off by about the condition number times ε, which for strong
+    /// anisotropic scales dwarfs the rounding of a single product.
+    pub fn inverse_residual(&self) -> f64 {
+        let r = self.inverse.mul(&self.matrix).0;
+        let mut worst = 0.0f64;
+        for (i, row) in r.iter().enumerate().take(3) {
+            for (j, v) in row.iter().enumerate() {
+                let identity = if i == j { 1.0 } else { 0.0 };
+                worst = worst.max((v - identity).abs());
+            }
+        }
+        2.0 * worst + gamma(4)
+    }
+
+    /// Bound on the rounding error, in object space, of the world point `p` taken into object
+    /// space: what a ray starting at `p` suffers when it is transformed for intersection.
+    pub fn inverse_error(&self, p: Vec3) -> Vec3 {
+        let inv = &self.inverse.0;
+        let g3 = gamma(3);
+        let e = |r: &[f64; 4]| {
+            g3 * ((r[0] * p.x).abs() + (r[1] * p.y).abs() + (r[2] * p.z).abs() + r[3].abs())
+        };
+        Vec3::new(e(&inv[0]), e(&inv[1]), e(&inv[2]))
+    }
+
     /// The world ray in object space, and the parameter shift `dt` to add back to an
     /// object-space distance. The origin's rounding error from the transform is absorbed by
     /// advancing it along the direction by `dt` (pbrt-v4 §6.8.6), so a ray leaving a surface
