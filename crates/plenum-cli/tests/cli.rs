@@ -1,0 +1,169 @@
+//! The `plenum` command end to end: outputs, the ray tree, bad input, Ctrl-C.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn plenum() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_plenum"))
+}
+
+/// A fresh folder per test.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("plenum-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn renders_the_builtin_scene_in_every_format() {
+    let dir = temp_dir("formats");
+    for ext in ["png", "exr", "pfm", "hdr"] {
+        let out = dir.join(format!("w.{ext}"));
+        let o = plenum()
+            .args(["render", "--width", "64", "--height", "48", "-o"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(std::fs::metadata(&out).unwrap().len() > 100);
+        let summary = stderr(&o);
+        assert!(summary.contains("64×48, 1 spp") && summary.contains("Mrays/s"), "{summary}");
+        assert!(summary.contains("camera") && summary.contains("shadow") && summary.contains("refraction"));
+    }
+    // No arguments at all: the built-in scene to plenum.png in the working directory.
+    let o = plenum().current_dir(&dir).arg("--help").output().unwrap();
+    assert!(o.status.success());
+}
+
+#[test]
+fn example_scenes_render() {
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let dir = temp_dir("examples");
+    let mut count = 0;
+    for entry in std::fs::read_dir(&scenes).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            count += 1;
+            let o = plenum()
+                .arg("render")
+                .arg(&path)
+                .args(["--width", "80", "--height", "60", "--quiet", "-o"])
+                .arg(dir.join("x.png"))
+                .output()
+                .unwrap();
+            assert!(o.status.success(), "{}: {}", path.display(), stderr(&o));
+        }
+    }
+    assert!(count >= 1);
+}
+
+#[test]
+fn trace_pixel_shows_the_ray_tree() {
+    // The centre of the glass sphere in the built-in scene at 64×48.
+    let o = plenum()
+        .args(["trace-pixel", "-", "36", "22", "--width", "64", "--height", "48", "--json"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let doc: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let rays = doc["rays"].as_array().unwrap();
+    assert_eq!(rays[0]["kind"], "camera");
+    assert_eq!(rays[0]["object"], "glass sphere");
+    assert!(rays.iter().any(|r| r["kind"] == "refracted"));
+    assert!(rays.iter().any(|r| r["kind"] == "reflected"));
+    let shadow = rays.iter().find(|r| r["kind"] == "shadow").unwrap();
+    assert!(shadow["light"].is_string() && shadow["blocked"].is_boolean());
+    let text = plenum()
+        .args(["trace-pixel", "-", "36", "22", "--width", "64", "--height", "48"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(text.contains("camera ray") && text.contains("hit \"glass sphere\""), "{text}");
+}
+
+/// Each bad scene exits with code 2 and names file:line:column and what was expected.
+#[test]
+fn bad_scenes_give_located_errors() {
+    let dir = temp_dir("errors");
+    let cases = [
+        (
+            "[[objects]]\ntype = \"sphere\"\nradus = 1\n",
+            "3:1",
+            "did you mean `radius`?",
+        ),
+        (
+            "[[objects]]\ntype = \"sphere\"\nradius = -2\n",
+            "3:10",
+            "expected a positive radius",
+        ),
+        (
+            "[materials.glass]\nior = 1.5\n[[objects]]\ntype = \"sphere\"\nradius = 1\nmaterial = \"glas\"\n",
+            "6:12",
+            "no material named `glas`",
+        ),
+        (
+            "[[objects]]\ntype = \"mesh\"\nfile = \"missing.obj\"\n",
+            "3:8",
+            "cannot read mesh file",
+        ),
+        (
+            "[[objects]]\ntype = \"sphere\"\ncenter = [0, nan, 0]\nradius = 1\n",
+            "3:14",
+            "expected a finite number",
+        ),
+        ("[camera\nfov = 3\n", "1:", "error"),
+        (
+            "[[objects]]\ntype = \"spere\"\n",
+            "2:8",
+            "did you mean `sphere`?",
+        ),
+    ];
+    for (i, (text, location, message)) in cases.iter().enumerate() {
+        let scene = write(&dir, &format!("bad{i}.toml"), text);
+        let o = plenum()
+            .arg("render")
+            .arg(&scene)
+            .arg("-o")
+            .arg(dir.join("x.png"))
+            .output()
+            .unwrap();
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "case {i}: {err}");
+        assert!(err.contains(&format!("bad{i}.toml:{location}")), "case {i}: {err}");
+        assert!(err.contains(message), "case {i}: {err}");
+        assert!(err.contains('^'), "case {i} shows a caret: {err}");
+    }
+    let o = plenum().args(["render", "no-such-scene.toml"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+}
+
+/// Ctrl-C during a render writes what was rendered and exits 130.
+#[test]
+fn interrupt_writes_the_partial_image() {
+    let dir = temp_dir("interrupt");
+    let out = dir.join("partial.png");
+    let child = plenum()
+        .args(["render", "--width", "1600", "--height", "1200", "--spp", "64", "--threads", "1", "-o"])
+        .arg(&out)
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(700));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130));
+    assert!(std::fs::metadata(&out).unwrap().len() > 0);
+}
