@@ -17,7 +17,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 #[derive(Parser)]
-#[command(name = "plenum", version, about = "Plenum: a ray tracer for learning, teaching and using ray tracing")]
+#[command(
+    name = "plenum",
+    version,
+    about = "Plenum: a ray tracer for learning, teaching and using ray tracing"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -197,7 +201,13 @@ fn run_render(args: RenderArgs) -> ExitCode {
 
     let exposure = args.exposure.unwrap_or(loaded.defaults.exposure) as f32;
     let film = &output.film;
-    if let Err(e) = plenum_image::write_image(&args.output, film.width, film.height, film.pixels(), exposure) {
+    if let Err(e) = plenum_image::write_image(
+        &args.output,
+        film.width,
+        film.height,
+        film.pixels(),
+        exposure,
+    ) {
         eprintln!("error: {e}");
         return ExitCode::from(1);
     }
@@ -218,7 +228,10 @@ fn run_render(args: RenderArgs) -> ExitCode {
         );
     }
     if !output.complete {
-        eprintln!("interrupted: wrote the part rendered so far to {}", args.output.display());
+        eprintln!(
+            "interrupted: wrote the part rendered so far to {}",
+            args.output.display()
+        );
         return ExitCode::from(130);
     }
     ExitCode::SUCCESS

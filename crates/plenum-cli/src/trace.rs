@@ -32,7 +32,12 @@ pub fn run(args: TracePixelArgs) -> ExitCode {
         });
         println!("{}", serde_json::to_string_pretty(&doc).unwrap_or_default());
     } else {
-        println!("pixel ({}, {}): colour {}", args.x, args.y, fmt_color(color));
+        println!(
+            "pixel ({}, {}): colour {}",
+            args.x,
+            args.y,
+            fmt_color(color)
+        );
         for root in (0..tree.nodes.len()).filter(|&i| tree.nodes[i].parent.is_none()) {
             print_node(&tree, root, 0);
         }
@@ -116,7 +121,9 @@ fn print_node(tree: &RayTree, id: usize, indent: usize) {
         );
     }
     if n.total_internal_reflection {
-        println!("{pad}  total internal reflection: the refracted weight goes to the reflected ray");
+        println!(
+            "{pad}  total internal reflection: the refracted weight goes to the reflected ray"
+        );
     }
     for stop in &n.stops {
         println!("{pad}  stopped: {}", stop.name());

@@ -37,8 +37,15 @@ fn renders_the_builtin_scene_in_every_format() {
         assert!(o.status.success(), "{}", stderr(&o));
         assert!(std::fs::metadata(&out).unwrap().len() > 100);
         let summary = stderr(&o);
-        assert!(summary.contains("64×48, 1 spp") && summary.contains("Mrays/s"), "{summary}");
-        assert!(summary.contains("camera") && summary.contains("shadow") && summary.contains("refraction"));
+        assert!(
+            summary.contains("64×48, 1 spp") && summary.contains("Mrays/s"),
+            "{summary}"
+        );
+        assert!(
+            summary.contains("camera")
+                && summary.contains("shadow")
+                && summary.contains("refraction")
+        );
     }
     // No arguments at all: the built-in scene to plenum.png in the working directory.
     let o = plenum().current_dir(&dir).arg("--help").output().unwrap();
@@ -71,7 +78,17 @@ fn example_scenes_render() {
 fn trace_pixel_shows_the_ray_tree() {
     // The centre of the glass sphere in the built-in scene at 64×48.
     let o = plenum()
-        .args(["trace-pixel", "-", "36", "22", "--width", "64", "--height", "48", "--json"])
+        .args([
+            "trace-pixel",
+            "-",
+            "36",
+            "22",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--json",
+        ])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
@@ -84,11 +101,23 @@ fn trace_pixel_shows_the_ray_tree() {
     let shadow = rays.iter().find(|r| r["kind"] == "shadow").unwrap();
     assert!(shadow["light"].is_string() && shadow["blocked"].is_boolean());
     let text = plenum()
-        .args(["trace-pixel", "-", "36", "22", "--width", "64", "--height", "48"])
+        .args([
+            "trace-pixel",
+            "-",
+            "36",
+            "22",
+            "--width",
+            "64",
+            "--height",
+            "48",
+        ])
         .output()
         .unwrap();
     let text = String::from_utf8_lossy(&text.stdout);
-    assert!(text.contains("camera ray") && text.contains("hit \"glass sphere\""), "{text}");
+    assert!(
+        text.contains("camera ray") && text.contains("hit \"glass sphere\""),
+        "{text}"
+    );
 }
 
 /// Each bad scene exits with code 2 and names file:line:column and what was expected.
@@ -139,11 +168,17 @@ fn bad_scenes_give_located_errors() {
             .unwrap();
         let err = stderr(&o);
         assert_eq!(o.status.code(), Some(2), "case {i}: {err}");
-        assert!(err.contains(&format!("bad{i}.toml:{location}")), "case {i}: {err}");
+        assert!(
+            err.contains(&format!("bad{i}.toml:{location}")),
+            "case {i}: {err}"
+        );
         assert!(err.contains(message), "case {i}: {err}");
         assert!(err.contains('^'), "case {i} shows a caret: {err}");
     }
-    let o = plenum().args(["render", "no-such-scene.toml"]).output().unwrap();
+    let o = plenum()
+        .args(["render", "no-such-scene.toml"])
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(2));
 }
 
@@ -153,7 +188,18 @@ fn interrupt_writes_the_partial_image() {
     let dir = temp_dir("interrupt");
     let out = dir.join("partial.png");
     let child = plenum()
-        .args(["render", "--width", "1600", "--height", "1200", "--spp", "64", "--threads", "1", "-o"])
+        .args([
+            "render",
+            "--width",
+            "1600",
+            "--height",
+            "1200",
+            "--spp",
+            "64",
+            "--threads",
+            "1",
+            "-o",
+        ])
         .arg(&out)
         .spawn()
         .unwrap();

@@ -71,6 +71,20 @@ impl Material {
         }
     }
 
+    /// Some coefficient is looked up by texture coordinates.
+    pub fn needs_uv(&self) -> bool {
+        [
+            &self.emissive,
+            &self.ambient,
+            &self.diffuse,
+            &self.specular,
+            &self.reflective,
+            &self.transmissive,
+        ]
+        .iter()
+        .any(|t| matches!(t, Texture::Checker2d { .. } | Texture::Image(_)))
+    }
+
     /// Light can pass through: shadow rays continue and rays may start inside.
     pub fn is_transmissive(&self) -> bool {
         !self.transmissive.is_black()

@@ -64,7 +64,10 @@ mod tests {
             let t = refract(d, n, 1.0 / 1.5).unwrap();
             assert!((t.length() - 1.0).abs() < 1e-12);
             let sin_t = t.x;
-            assert!((1.0 * theta_i.sin() - 1.5 * sin_t).abs() < 1e-12, "at {deg}°");
+            assert!(
+                (1.0 * theta_i.sin() - 1.5 * sin_t).abs() < 1e-12,
+                "at {deg}°"
+            );
             assert!(t.y < 0.0);
         }
     }
@@ -83,7 +86,10 @@ mod tests {
         let c = theta_c.to_degrees();
         assert!(refract(ray_at(c - 0.01), n, 1.5).is_some());
         assert!(refract(ray_at(c + 0.01), n, 1.5).is_none());
-        assert_eq!(fresnel_dielectric((c + 0.01).to_radians().cos(), 1.5, 1.0), 1.0);
+        assert_eq!(
+            fresnel_dielectric((c + 0.01).to_radians().cos(), 1.5, 1.0),
+            1.0
+        );
     }
 
     #[test]

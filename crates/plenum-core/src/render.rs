@@ -126,6 +126,14 @@ pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> 
     let whitted = Whitted::new(scene, settings.integrator);
     let mut tree = RayTree::default();
     let mut counts = RayCounts::default();
-    let c = render_pixel(&whitted, &camera, settings, x, y, &mut counts, Some(&mut tree));
+    let c = render_pixel(
+        &whitted,
+        &camera,
+        settings,
+        x,
+        y,
+        &mut counts,
+        Some(&mut tree),
+    );
     (tree, c)
 }

@@ -48,10 +48,17 @@ impl Primitive {
         }
     }
 
-    pub fn interaction(&self, ray: &Ray, hit: &HitRecord, primitive: u32) -> Interaction {
+    /// The hit in world space; `want_uv` asks for texture coordinates.
+    pub fn interaction(
+        &self,
+        ray: &Ray,
+        hit: &HitRecord,
+        primitive: u32,
+        want_uv: bool,
+    ) -> Interaction {
         match &self.to_world {
             None => {
-                let g = self.shape.surface(ray, hit);
+                let g = self.shape.surface(ray, hit, want_uv);
                 Interaction {
                     p: g.p,
                     p_error: g.p_error,
@@ -70,7 +77,7 @@ impl Primitive {
                     t: hit.t - dt,
                     ..*hit
                 };
-                let g = self.shape.surface(&local, &local_hit);
+                let g = self.shape.surface(&local, &local_hit, want_uv);
                 let (p, p_error) = t.point_with_error(g.p, g.p_error);
                 // A spawned ray is intersected in object space, where what keeps it off the
                 // surface is its distance along the object normal. Offsetting by the world
@@ -148,7 +155,12 @@ impl Scene {
 
     /// Calls `visit(primitive, hit)` with each primitive's nearest hit in (0, t_max), in no
     /// particular order, until `visit` returns false: an any-hit query for shadow rays.
-    pub fn for_each_hit(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(u32, &HitRecord) -> bool) {
+    pub fn for_each_hit(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        mut visit: impl FnMut(u32, &HitRecord) -> bool,
+    ) {
         let mut go_on = true;
         self.bvh.for_each_candidate(ray, t_max, |i| {
             let prim = self.bounded_index(i);
@@ -181,7 +193,8 @@ impl Scene {
     }
 
     pub fn interaction(&self, ray: &Ray, primitive: u32, hit: &HitRecord) -> Interaction {
-        self.primitives[primitive as usize].interaction(ray, hit, primitive)
+        let want_uv = self.material_of(primitive).needs_uv();
+        self.primitives[primitive as usize].interaction(ray, hit, primitive, want_uv)
     }
 
     pub fn material_of(&self, primitive: u32) -> &Material {

@@ -10,9 +10,17 @@ use std::sync::Arc;
 pub enum Texture {
     Constant(Color),
     /// Squares of side 1/`scale` in (u, v).
-    Checker2d { even: Color, odd: Color, scale: f64 },
+    Checker2d {
+        even: Color,
+        odd: Color,
+        scale: f64,
+    },
     /// Cubes of side 1/`scale` in object space.
-    Checker3d { even: Color, odd: Color, scale: f64 },
+    Checker3d {
+        even: Color,
+        odd: Color,
+        scale: f64,
+    },
     Image(Arc<ImageTexture>),
 }
 

@@ -51,9 +51,13 @@ fn random_shape(rng: &mut Rng, which: usize) -> (Shape, Kind) {
             Kind::Convex,
         ),
         1 => {
-            let mesh =
-                TriangleMesh::new(vec![point(rng), point(rng), point(rng)], vec![[0, 1, 2]], vec![], vec![])
-                    .unwrap();
+            let mesh = TriangleMesh::new(
+                vec![point(rng), point(rng), point(rng)],
+                vec![[0, 1, 2]],
+                vec![],
+                vec![],
+            )
+            .unwrap();
             (Shape::Mesh(Arc::new(mesh)), Kind::Planar)
         }
         2 => {
@@ -69,10 +73,17 @@ fn random_shape(rng: &mut Rng, which: usize) -> (Shape, Kind) {
                     c + (s * a.cos() + t * a.sin()) * r
                 })
                 .collect();
-            (Shape::Polygon(Box::new(Polygon::new(vertices).unwrap())), Kind::Planar)
+            (
+                Shape::Polygon(Box::new(Polygon::new(vertices).unwrap())),
+                Kind::Planar,
+            )
         }
         3 => (
-            Shape::Disk(Disk::new(point(rng), uniform_sphere(rng), log_uniform(rng, 0.01, 100.0))),
+            Shape::Disk(Disk::new(
+                point(rng),
+                uniform_sphere(rng),
+                log_uniform(rng, 0.01, 100.0),
+            )),
             Kind::Planar,
         ),
         4 => {
@@ -97,7 +108,14 @@ fn random_shape(rng: &mut Rng, which: usize) -> (Shape, Kind) {
 
 #[test]
 fn spawned_rays_never_rehit_their_surface() {
-    let names = ["sphere", "triangle", "polygon", "disk", "box", "capped cylinder"];
+    let names = [
+        "sphere",
+        "triangle",
+        "polygon",
+        "disk",
+        "box",
+        "capped cylinder",
+    ];
     for (which, name) in names.iter().enumerate() {
         let mut rng = Rng::new(0x5eed + which as u64, 7);
         let mut hits = 0;
@@ -121,15 +139,21 @@ fn spawned_rays_never_rehit_their_surface() {
             };
             let (centre, radius) = bounds.bounding_sphere();
             // From outside the bounding sphere toward a random point of the box.
-            let origin = centre + uniform_sphere(&mut rng) * radius * log_uniform(&mut rng, 1.5, 100.0);
+            let origin =
+                centre + uniform_sphere(&mut rng) * radius * log_uniform(&mut rng, 1.5, 100.0);
             let d = bounds.diagonal();
-            let target = bounds.min + Vec3::new(d.x * rng.uniform(), d.y * rng.uniform(), d.z * rng.uniform());
+            let target = bounds.min
+                + Vec3::new(
+                    d.x * rng.uniform(),
+                    d.y * rng.uniform(),
+                    d.z * rng.uniform(),
+                );
             let ray = Ray::new(origin, target - origin);
             let Some(hit) = prim.intersect(&ray, f64::INFINITY) else {
                 continue;
             };
             hits += 1;
-            let it = prim.interaction(&ray, &hit, 0);
+            let it = prim.interaction(&ray, &hit, 0, true);
             for _ in 0..8 {
                 let w = uniform_sphere(&mut rng);
                 let spawn = Ray::new(offset_ray_origin(it.p, it.p_error, it.n, w), w);
@@ -153,7 +177,11 @@ fn spawned_rays_never_rehit_their_surface() {
                         let curved = which == 0 || (which == 5 && hit.part == 0);
                         let chord = (spawn.at(h.t) - it.p).length();
                         assert!(
-                            if curved { chord > 1e-12 * radius } else { h.part != hit.part },
+                            if curved {
+                                chord > 1e-12 * radius
+                            } else {
+                                h.part != hit.part
+                            },
                             "{name} (trial {trial}): an inward ray re-hit its start"
                         );
                     }

@@ -27,7 +27,9 @@ impl SceneError {
         let start = span.start.min(text.len());
         let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
         let line_end = text[start..].find('\n').map_or(text.len(), |i| start + i);
-        let source_line = text[line_start..line_end].trim_end_matches('\r').to_string();
+        let source_line = text[line_start..line_end]
+            .trim_end_matches('\r')
+            .to_string();
         let line = text[..start].matches('\n').count() + 1;
         let column = text[line_start..start].chars().count() + 1;
         let end = span.end.clamp(start, line_end);
@@ -95,7 +97,10 @@ impl fmt::Display for SceneError {
 impl std::error::Error for SceneError {}
 
 /// The candidate closest to `word` by edit distance, if it is close enough to be a typo.
-pub fn did_you_mean<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+pub fn did_you_mean<'a>(
+    word: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> Option<&'a str> {
     candidates
         .into_iter()
         .map(|c| (edit_distance(word, c), c))
@@ -140,7 +145,10 @@ mod tests {
     #[test]
     fn suggestions() {
         assert_eq!(did_you_mean("radus", ["center", "radius"]), Some("radius"));
-        assert_eq!(did_you_mean("colour", ["color", "intensity"]), Some("color"));
+        assert_eq!(
+            did_you_mean("colour", ["color", "intensity"]),
+            Some("color")
+        );
         assert_eq!(did_you_mean("zzz", ["center", "radius"]), None);
     }
 }

@@ -64,6 +64,10 @@ pub const BUILTIN_SCENE: &str = include_str!("../../../scenes/whitted.toml");
 /// Whitted's 1980 picture: a checkerboard floor, a glass sphere and a mirror sphere under
 /// two point lights.
 pub fn builtin_scene() -> LoadedScene {
-    parse_scene(Path::new("<built-in whitted.toml>"), BUILTIN_SCENE, Path::new("."))
-        .expect("the built-in scene is valid")
+    parse_scene(
+        Path::new("<built-in whitted.toml>"),
+        BUILTIN_SCENE,
+        Path::new("."),
+    )
+    .expect("the built-in scene is valid")
 }

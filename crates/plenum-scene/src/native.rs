@@ -18,7 +18,15 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use toml::de::{DeTable, DeValue};
 
-const TOP_LEVEL: &[&str] = &["background", "render", "camera", "materials", "meshes", "lights", "objects"];
+const TOP_LEVEL: &[&str] = &[
+    "background",
+    "render",
+    "camera",
+    "materials",
+    "meshes",
+    "lights",
+    "objects",
+];
 const COMMON: [&str; 4] = ["type", "name", "material", "transform"];
 
 /// Parses a native scene. `base_dir` resolves relative paths (meshes, textures).
@@ -48,7 +56,10 @@ pub fn parse(path: &Path, text: &str, base_dir: &Path) -> Result<(SceneBuilder, 
     }
     if let Some(v) = top.get("materials") {
         let DeValue::Table(t) = v.get_ref() else {
-            return Err(src.error(v.span(), "expected a table of named materials: [materials.NAME]"));
+            return Err(src.error(
+                v.span(),
+                "expected a table of named materials: [materials.NAME]",
+            ));
         };
         for (name, value) in t.iter() {
             reader.material(name.get_ref(), value)?;
@@ -59,18 +70,30 @@ pub fn parse(path: &Path, text: &str, base_dir: &Path) -> Result<(SceneBuilder, 
             return Err(src.error(v.span(), "expected a table of named meshes: [meshes.NAME]"));
         };
         for (name, value) in t.iter() {
-            let f = src.table(value, &format!("mesh `{}`", name.get_ref()), &["file", "positions", "indices", "normals", "uvs"])?;
+            let f = src.table(
+                value,
+                &format!("mesh `{}`", name.get_ref()),
+                &["file", "positions", "indices", "normals", "uvs"],
+            )?;
             let mesh = reader.mesh_data(&f)?;
             reader.meshes.insert(name.get_ref().to_string(), mesh);
         }
     }
     if let Some(v) = top.get("lights") {
-        for (i, light) in src.array(v, "an array of lights: [[lights]]")?.iter().enumerate() {
+        for (i, light) in src
+            .array(v, "an array of lights: [[lights]]")?
+            .iter()
+            .enumerate()
+        {
             reader.light(i, light)?;
         }
     }
     if let Some(v) = top.get("objects") {
-        for (i, object) in src.array(v, "an array of objects: [[objects]]")?.iter().enumerate() {
+        for (i, object) in src
+            .array(v, "an array of objects: [[objects]]")?
+            .iter()
+            .enumerate()
+        {
             reader.object(i, object)?;
         }
     }
@@ -87,7 +110,11 @@ struct Reader<'s> {
 
 impl<'s> Reader<'s> {
     fn render(&mut self, v: &Value<'s>, d: &mut RenderDefaults) -> Result<()> {
-        let f = self.src.table(v, "[render]", &["spp", "max_depth", "min_weight", "exposure"])?;
+        let f = self.src.table(
+            v,
+            "[render]",
+            &["spp", "max_depth", "min_weight", "exposure"],
+        )?;
         if let Some(spp) = f.count("spp")? {
             d.spp = spp.max(1);
         }
@@ -100,27 +127,44 @@ impl<'s> Reader<'s> {
     }
 
     fn camera(&mut self, v: &Value<'s>, d: &mut RenderDefaults) -> Result<()> {
-        let f = self.src.table(v, "[camera]", &["position", "look_at", "up", "fov", "resolution"])?;
+        let f = self.src.table(
+            v,
+            "[camera]",
+            &["position", "look_at", "up", "fov", "resolution"],
+        )?;
         let c = CameraSettings::default();
         let position = f.vec3_or("position", c.position)?;
         let look_at = f.vec3_or("look_at", c.look_at)?;
         if (look_at - position).length_squared() == 0.0 {
-            let span = f.get("look_at").or(f.get("position")).map_or(f.span.clone(), |v| v.span());
-            return Err(self.src.error(span, "the camera looks at its own position: expected look_at ≠ position"));
+            let span = f
+                .get("look_at")
+                .or(f.get("position"))
+                .map_or(f.span.clone(), |v| v.span());
+            return Err(self.src.error(
+                span,
+                "the camera looks at its own position: expected look_at ≠ position",
+            ));
         }
         let up = f.direction("up", Some(c.up))?;
         if up.cross(look_at - position).length_squared() == 0.0 {
             let span = f.get("up").map_or(f.span.clone(), |v| v.span());
-            return Err(self.src.error(span, "`up` is parallel to the viewing direction"));
+            return Err(self
+                .src
+                .error(span, "`up` is parallel to the viewing direction"));
         }
         let fov = f.number_or("fov", c.fov_degrees)?;
         if !(fov > 0.0 && fov < 180.0) {
-            return Err(self.src.error(f.get("fov").map_or(f.span.clone(), |v| v.span()), format!("expected a field of view between 0 and 180 degrees, found {fov}")));
+            return Err(self.src.error(
+                f.get("fov").map_or(f.span.clone(), |v| v.span()),
+                format!("expected a field of view between 0 and 180 degrees, found {fov}"),
+            ));
         }
         if let Some(r) = f.get("resolution") {
             let [w, h] = self.src.numbers::<2>(r, "[width, height] in pixels")?;
             if w < 1.0 || h < 1.0 || w.fract() != 0.0 || h.fract() != 0.0 {
-                return Err(self.src.error(r.span(), "expected a resolution of whole pixels ≥ 1"));
+                return Err(self
+                    .src
+                    .error(r.span(), "expected a resolution of whole pixels ≥ 1"));
             }
             d.width = w as u32;
             d.height = h as u32;
@@ -142,7 +186,9 @@ impl<'s> Reader<'s> {
                 self.non_negative(v, Color::gray(g))
             }
             _ => {
-                let c = self.src.numbers::<3>(v, "a colour: [r, g, b] or a number")?;
+                let c = self
+                    .src
+                    .numbers::<3>(v, "a colour: [r, g, b] or a number")?;
                 self.non_negative(v, Color::new(c[0], c[1], c[2]))
             }
         }
@@ -161,13 +207,17 @@ impl<'s> Reader<'s> {
             return Ok(Texture::Constant(self.color(v)?));
         };
         let kind = {
-            let f = self.src.table(v, "a texture", &["texture", "even", "odd", "scale", "file"])?;
+            let f = self
+                .src
+                .table(v, "a texture", &["texture", "even", "odd", "scale", "file"])?;
             let k = f.required("texture")?;
             (self.src.string(k)?.to_string(), k.span())
         };
         match kind.0.as_str() {
             "checker" | "checker3d" => {
-                let f = self.src.table(v, "a checker texture", &["texture", "even", "odd", "scale"])?;
+                let f =
+                    self.src
+                        .table(v, "a checker texture", &["texture", "even", "odd", "scale"])?;
                 let even = f.get("even").map_or(Ok(Color::WHITE), |c| self.color(c))?;
                 let odd = f.get("odd").map_or(Ok(Color::BLACK), |c| self.color(c))?;
                 let scale = f.positive("scale", Some(1.0))?;
@@ -178,7 +228,9 @@ impl<'s> Reader<'s> {
                 })
             }
             "image" => {
-                let f = self.src.table(v, "an image texture", &["texture", "file", "scale"])?;
+                let f = self
+                    .src
+                    .table(v, "an image texture", &["texture", "file", "scale"])?;
                 let file = f.required("file")?;
                 let path = self.base_dir.join(self.src.string(file)?);
                 let texels = plenum_image::read_texture(&path)
@@ -188,23 +240,39 @@ impl<'s> Reader<'s> {
                     Some(s) => self.src.numbers::<2>(s, "[u, v] repeats")?,
                 };
                 let (width, height) = (texels.width, texels.height);
-                let texels = texels.rgb.iter().map(|p| Color::new(p[0] as f64, p[1] as f64, p[2] as f64)).collect();
+                let texels = texels
+                    .rgb
+                    .iter()
+                    .map(|p| Color::new(p[0] as f64, p[1] as f64, p[2] as f64))
+                    .collect();
                 let image = ImageTexture::new(width, height, texels, scale)
                     .ok_or_else(|| self.src.error(file.span(), "the image is empty"))?;
                 Ok(Texture::Image(Arc::new(image)))
             }
             other => {
                 let e = self.src.error(kind.1, format!("unknown texture `{other}`"));
-                Err(match did_you_mean(other, ["checker", "checker3d", "image"]) {
-                    Some(s) => e.with_help(format!("did you mean `{s}`?")),
-                    None => e.with_help("expected one of: checker, checker3d, image"),
-                })
+                Err(
+                    match did_you_mean(other, ["checker", "checker3d", "image"]) {
+                        Some(s) => e.with_help(format!("did you mean `{s}`?")),
+                        None => e.with_help("expected one of: checker, checker3d, image"),
+                    },
+                )
             }
         }
     }
 
     fn material(&mut self, name: &str, v: &Value<'s>) -> Result<()> {
-        const FIELDS: &[&str] = &["emissive", "ambient", "diffuse", "specular", "shininess", "reflective", "transmissive", "ior", "fresnel"];
+        const FIELDS: &[&str] = &[
+            "emissive",
+            "ambient",
+            "diffuse",
+            "specular",
+            "shininess",
+            "reflective",
+            "transmissive",
+            "ior",
+            "fresnel",
+        ];
         let f = self.src.table(v, &format!("material `{name}`"), FIELDS)?;
         let d = Material::default();
         let tex = |key: &str, default: Texture| f.get(key).map_or(Ok(default), |v| self.texture(v));
@@ -221,7 +289,9 @@ impl<'s> Reader<'s> {
                 Some(s) => {
                     let n = self.src.number(s)?;
                     if n < 0.0 {
-                        return Err(self.src.error(s.span(), format!("expected a shininess ≥ 0, found {n}")));
+                        return Err(self
+                            .src
+                            .error(s.span(), format!("expected a shininess ≥ 0, found {n}")));
                     }
                     n
                 }
@@ -240,7 +310,8 @@ impl<'s> Reader<'s> {
         let kind = self.kind(v, "a light", &["point", "directional", "spot", "ambient"])?;
         let what = format!("{kind} light");
         let name_of = |f: &Fields| -> Result<String> {
-            Ok(f.string("name")?.map_or_else(|| format!("{kind} light {}", index + 1), str::to_string))
+            Ok(f.string("name")?
+                .map_or_else(|| format!("{kind} light {}", index + 1), str::to_string))
         };
         let intensity = |f: &Fields| -> Result<Color> {
             let c = f.get("color").map_or(Ok(Color::WHITE), |c| self.color(c))?;
@@ -248,7 +319,18 @@ impl<'s> Reader<'s> {
         };
         match kind.as_str() {
             "point" => {
-                let f = self.src.table(v, &what, &["type", "name", "position", "color", "intensity", "attenuation"])?;
+                let f = self.src.table(
+                    v,
+                    &what,
+                    &[
+                        "type",
+                        "name",
+                        "position",
+                        "color",
+                        "intensity",
+                        "attenuation",
+                    ],
+                )?;
                 let light = Light::Point {
                     position: f.required_vec3("position")?,
                     intensity: intensity(&f)?,
@@ -257,7 +339,11 @@ impl<'s> Reader<'s> {
                 self.builder.add_light(name_of(&f)?, light);
             }
             "directional" => {
-                let f = self.src.table(v, &what, &["type", "name", "direction", "color", "intensity"])?;
+                let f = self.src.table(
+                    v,
+                    &what,
+                    &["type", "name", "direction", "color", "intensity"],
+                )?;
                 let light = Light::Directional {
                     direction: f.direction("direction", None)?.normalized(),
                     intensity: intensity(&f)?,
@@ -265,11 +351,28 @@ impl<'s> Reader<'s> {
                 self.builder.add_light(name_of(&f)?, light);
             }
             "spot" => {
-                let f = self.src.table(v, &what, &["type", "name", "position", "direction", "inner_angle", "outer_angle", "color", "intensity", "attenuation"])?;
+                let f = self.src.table(
+                    v,
+                    &what,
+                    &[
+                        "type",
+                        "name",
+                        "position",
+                        "direction",
+                        "inner_angle",
+                        "outer_angle",
+                        "color",
+                        "intensity",
+                        "attenuation",
+                    ],
+                )?;
                 let outer = f.positive("outer_angle", Some(30.0))?;
                 let inner = f.number_or("inner_angle", outer.min(20.0))?;
                 if !(0.0..=outer).contains(&inner) || outer > 180.0 {
-                    let span = f.get("inner_angle").or(f.get("outer_angle")).map_or(f.span.clone(), |v| v.span());
+                    let span = f
+                        .get("inner_angle")
+                        .or(f.get("outer_angle"))
+                        .map_or(f.span.clone(), |v| v.span());
                     return Err(self.src.error(span, format!("expected 0 ≤ inner_angle ≤ outer_angle ≤ 180 degrees, found {inner} and {outer}")));
                 }
                 let light = Light::Spot {
@@ -283,7 +386,9 @@ impl<'s> Reader<'s> {
                 self.builder.add_light(name_of(&f)?, light);
             }
             _ => {
-                let f = self.src.table(v, &what, &["type", "name", "color", "intensity"])?;
+                let f = self
+                    .src
+                    .table(v, &what, &["type", "name", "color", "intensity"])?;
                 self.builder.ambient += intensity(&f)?;
             }
         }
@@ -294,9 +399,14 @@ impl<'s> Reader<'s> {
         let Some(v) = f.get("attenuation") else {
             return Ok(Attenuation::default());
         };
-        let [a, b, c] = self.src.numbers::<3>(v, "[constant, linear, quadratic] coefficients")?;
+        let [a, b, c] = self
+            .src
+            .numbers::<3>(v, "[constant, linear, quadratic] coefficients")?;
         if a < 0.0 || b < 0.0 || c < 0.0 || a + b + c == 0.0 {
-            return Err(self.src.error(v.span(), "expected attenuation coefficients ≥ 0, not all zero"));
+            return Err(self.src.error(
+                v.span(),
+                "expected attenuation coefficients ≥ 0, not all zero",
+            ));
         }
         Ok(Attenuation {
             constant: a,
@@ -308,18 +418,27 @@ impl<'s> Reader<'s> {
     /// The `type` of a light or object, checked against the known kinds.
     fn kind(&self, v: &Value<'s>, what: &str, kinds: &[&'static str]) -> Result<String> {
         let DeValue::Table(t) = v.get_ref() else {
-            return Err(self.src.error(v.span(), format!("expected a table for {what}")));
+            return Err(self
+                .src
+                .error(v.span(), format!("expected a table for {what}")));
         };
         let Some(k) = t.get("type") else {
             let start = v.span().start;
-            let end = self.src.text[start..].find('\n').map_or(self.src.text.len(), |i| start + i);
-            return Err(self.src.error(start..end, format!("missing field `type` in {what}")).with_help(format!("expected one of: {}", kinds.join(", "))));
+            let end = self.src.text[start..]
+                .find('\n')
+                .map_or(self.src.text.len(), |i| start + i);
+            return Err(self
+                .src
+                .error(start..end, format!("missing field `type` in {what}"))
+                .with_help(format!("expected one of: {}", kinds.join(", "))));
         };
         let kind = self.src.string(k)?;
         if kinds.contains(&kind) {
             return Ok(kind.to_string());
         }
-        let e = self.src.error(k.span(), format!("unknown type `{kind}` for {what}"));
+        let e = self
+            .src
+            .error(k.span(), format!("unknown type `{kind}` for {what}"));
         Err(match did_you_mean(kind, kinds.iter().copied()) {
             Some(s) => e.with_help(format!("did you mean `{s}`?")),
             None => e.with_help(format!("expected one of: {}", kinds.join(", "))),
@@ -327,7 +446,17 @@ impl<'s> Reader<'s> {
     }
 
     fn object(&mut self, index: usize, v: &Value<'s>) -> Result<()> {
-        const KINDS: &[&str] = &["sphere", "plane", "disk", "box", "cylinder", "cone", "polygon", "polyhedron", "mesh"];
+        const KINDS: &[&str] = &[
+            "sphere",
+            "plane",
+            "disk",
+            "box",
+            "cylinder",
+            "cone",
+            "polygon",
+            "polyhedron",
+            "mesh",
+        ];
         let kind = self.kind(v, "an object", KINDS)?;
         let fields: &[&'static str] = match kind.as_str() {
             "sphere" => &["center", "radius"],
@@ -348,8 +477,11 @@ impl<'s> Reader<'s> {
             None => Transform::IDENTITY,
         };
         let material = self.material_ref(&f)?;
-        let name = f.string("name")?.map_or_else(|| format!("{kind} {}", index + 1), str::to_string);
-        self.builder.add_object(name, shape, placement.after(&frame), material);
+        let name = f
+            .string("name")?
+            .map_or_else(|| format!("{kind} {}", index + 1), str::to_string);
+        self.builder
+            .add_object(name, shape, placement.after(&frame), material);
         Ok(())
     }
 
@@ -366,7 +498,9 @@ impl<'s> Reader<'s> {
         if let Some(&id) = self.materials.get(name) {
             return Ok(id);
         }
-        let e = self.src.error(v.span(), format!("no material named `{name}` is defined"));
+        let e = self
+            .src
+            .error(v.span(), format!("no material named `{name}` is defined"));
         let mut known: Vec<&str> = self.materials.keys().map(String::as_str).collect();
         known.sort();
         Err(match did_you_mean(name, known.iter().copied()) {
@@ -380,13 +514,26 @@ impl<'s> Reader<'s> {
     fn shape(&mut self, kind: &str, f: &Fields<'_, 's>) -> Result<(Shape, Transform)> {
         let src = self.src;
         let shape = match kind {
-            "sphere" => Shape::Sphere(Sphere::new(f.vec3_or("center", Vec3::ZERO)?, f.positive("radius", None)?)),
-            "plane" => Shape::Plane(Plane::new(f.vec3_or("point", Vec3::ZERO)?, f.direction("normal", None)?)),
-            "disk" => Shape::Disk(Disk::new(f.vec3_or("center", Vec3::ZERO)?, f.direction("normal", None)?, f.positive("radius", None)?)),
+            "sphere" => Shape::Sphere(Sphere::new(
+                f.vec3_or("center", Vec3::ZERO)?,
+                f.positive("radius", None)?,
+            )),
+            "plane" => Shape::Plane(Plane::new(
+                f.vec3_or("point", Vec3::ZERO)?,
+                f.direction("normal", None)?,
+            )),
+            "disk" => Shape::Disk(Disk::new(
+                f.vec3_or("center", Vec3::ZERO)?,
+                f.direction("normal", None)?,
+                f.positive("radius", None)?,
+            )),
             "box" => {
                 let (min, max) = (f.required_vec3("min")?, f.required_vec3("max")?);
                 if min.x >= max.x || min.y >= max.y || min.z >= max.z {
-                    return Err(src.error(f.required("max")?.span(), "expected max greater than min on every axis"));
+                    return Err(src.error(
+                        f.required("max")?.span(),
+                        "expected max greater than min on every axis",
+                    ));
                 }
                 Shape::Cuboid(Cuboid::new(min, max))
             }
@@ -409,16 +556,26 @@ impl<'s> Reader<'s> {
                 } else {
                     let top_radius = f.number_or("top_radius", 0.0)?;
                     if top_radius < 0.0 {
-                        return Err(src.error(f.required("top_radius")?.span(), format!("expected a top_radius ≥ 0, found {top_radius}")));
+                        return Err(src.error(
+                            f.required("top_radius")?.span(),
+                            format!("expected a top_radius ≥ 0, found {top_radius}"),
+                        ));
                     }
-                    Shape::Cone(Cone { radius0: radius, radius1: top_radius, height, capped })
+                    Shape::Cone(Cone {
+                        radius0: radius,
+                        radius1: top_radius,
+                        height,
+                        capped,
+                    })
                 };
                 return Ok((shape, frame));
             }
             "polygon" => {
                 let v = f.required("vertices")?;
                 let vertices = self.points(v)?;
-                Shape::Polygon(Box::new(Polygon::new(vertices).map_err(|e| src.error(v.span(), e.to_string()))?))
+                Shape::Polygon(Box::new(
+                    Polygon::new(vertices).map_err(|e| src.error(v.span(), e.to_string()))?,
+                ))
             }
             "polyhedron" => {
                 let vs = f.required("vertices")?;
@@ -430,23 +587,34 @@ impl<'s> Reader<'s> {
                     for i in src.array(face, "a face: an array of vertex indices")? {
                         let index = src.index(i)?;
                         if index as usize >= vertices.len() {
-                            return Err(src.error(i.span(), format!("vertex index {index} is out of range: there are {} vertices", vertices.len())));
+                            return Err(src.error(
+                                i.span(),
+                                format!(
+                                    "vertex index {index} is out of range: there are {} vertices",
+                                    vertices.len()
+                                ),
+                            ));
                         }
                         loop_.push(index);
                     }
                     faces.push(loop_);
                 }
-                Shape::Polyhedron(Box::new(Polyhedron::new(&vertices, &faces).map_err(|e| src.error(fv.span(), e.to_string()))?))
+                Shape::Polyhedron(Box::new(
+                    Polyhedron::new(&vertices, &faces)
+                        .map_err(|e| src.error(fv.span(), e.to_string()))?,
+                ))
             }
             _ => {
                 if let Some(m) = f.get("mesh") {
                     let name = src.string(m)?;
                     let Some(mesh) = self.meshes.get(name) else {
                         let e = src.error(m.span(), format!("no mesh named `{name}` is defined"));
-                        return Err(match did_you_mean(name, self.meshes.keys().map(String::as_str)) {
-                            Some(s) => e.with_help(format!("did you mean `{s}`?")),
-                            None => e.with_help("define it in a [meshes.NAME] table"),
-                        });
+                        return Err(
+                            match did_you_mean(name, self.meshes.keys().map(String::as_str)) {
+                                Some(s) => e.with_help(format!("did you mean `{s}`?")),
+                                None => e.with_help("define it in a [meshes.NAME] table"),
+                            },
+                        );
                     };
                     Shape::Mesh(mesh.clone())
                 } else {
@@ -472,9 +640,14 @@ impl<'s> Reader<'s> {
             let rel = src.string(file)?;
             let path = self.base_dir.join(rel);
             let text = std::fs::read_to_string(&path).map_err(|e| {
-                src.error(file.span(), format!("cannot read mesh file `{}`: {e}", path.display()))
+                src.error(
+                    file.span(),
+                    format!("cannot read mesh file `{}`: {e}", path.display()),
+                )
             })?;
-            let is_obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+            let is_obj = path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
             if !is_obj {
                 return Err(src.error(file.span(), "expected an OBJ mesh file (.obj)"));
             }
@@ -487,13 +660,23 @@ impl<'s> Reader<'s> {
         for tri in src.array(iv, "an array of triangles [[i, j, k], …]")? {
             let items = src.array(tri, "a triangle: [i, j, k]")?;
             if items.len() != 3 {
-                return Err(src.error(tri.span(), format!("expected a triangle of 3 indices, found {}", items.len())));
+                return Err(src.error(
+                    tri.span(),
+                    format!("expected a triangle of 3 indices, found {}", items.len()),
+                ));
             }
             let mut t = [0u32; 3];
             for (slot, i) in t.iter_mut().zip(items) {
                 *slot = src.index(i)?;
                 if *slot as usize >= positions.len() {
-                    return Err(src.error(i.span(), format!("vertex index {} is out of range: there are {} positions", slot, positions.len())));
+                    return Err(src.error(
+                        i.span(),
+                        format!(
+                            "vertex index {} is out of range: there are {} positions",
+                            slot,
+                            positions.len()
+                        ),
+                    ));
                 }
             }
             triangles.push(t);
@@ -520,11 +703,18 @@ impl<'s> Reader<'s> {
         let src = self.src;
         let steps: Vec<&Value<'s>> = match v.get_ref() {
             DeValue::Table(_) => vec![v],
-            _ => src.array(v, "a list of transforms [{ translate = … }, …]")?.iter().collect(),
+            _ => src
+                .array(v, "a list of transforms [{ translate = … }, …]")?
+                .iter()
+                .collect(),
         };
         let mut total = Transform::IDENTITY;
         for step in steps {
-            let f = src.table(step, "a transform step", &["translate", "rotate", "scale", "matrix"])?;
+            let f = src.table(
+                step,
+                "a transform step",
+                &["translate", "rotate", "scale", "matrix"],
+            )?;
             let (key, value) = match ["translate", "rotate", "scale", "matrix"].iter().filter_map(|k| f.get(k).map(|v| (*k, v))).collect::<Vec<_>>()[..] {
                 [one] => one,
                 _ => return Err(src.error(step.span(), "expected exactly one of translate, rotate, scale or matrix in each transform step")),
@@ -533,7 +723,10 @@ impl<'s> Reader<'s> {
                 "translate" => Some(Transform::translate(src.vec3(value)?)),
                 "rotate" => {
                     let r = src.table(value, "a rotation", &["axis", "degrees"])?;
-                    Transform::rotate(r.direction("axis", None)?, r.src.number(r.required("degrees")?)?)
+                    Transform::rotate(
+                        r.direction("axis", None)?,
+                        r.src.number(r.required("degrees")?)?,
+                    )
                 }
                 "scale" => {
                     let s = match value.get_ref() {
@@ -545,7 +738,9 @@ impl<'s> Reader<'s> {
                 _ => {
                     let rows = src.array(value, "a 4×4 matrix: 4 rows of 4 numbers")?;
                     if rows.len() != 4 {
-                        return Err(src.error(value.span(), "expected a 4×4 matrix: 4 rows of 4 numbers"));
+                        return Err(
+                            src.error(value.span(), "expected a 4×4 matrix: 4 rows of 4 numbers")
+                        );
                     }
                     let mut m = [[0.0; 4]; 4];
                     for (row, r) in m.iter_mut().zip(rows) {
@@ -554,7 +749,12 @@ impl<'s> Reader<'s> {
                     Transform::from_matrix(Matrix4(m))
                 }
             };
-            let t = t.ok_or_else(|| src.error(value.span(), format!("this {key} is singular or not affine: it cannot be inverted")))?;
+            let t = t.ok_or_else(|| {
+                src.error(
+                    value.span(),
+                    format!("this {key} is singular or not affine: it cannot be inverted"),
+                )
+            })?;
             total = t.after(&total);
         }
         Ok(total)

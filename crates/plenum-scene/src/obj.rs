@@ -28,16 +28,25 @@ pub fn parse_obj(path: &Path, text: &str) -> Result<TriangleMesh, SceneError> {
         let Some((keyword, _)) = tokens.next() else {
             continue;
         };
-        let err = |span: (usize, usize), msg: String| SceneError::at(path, text, span.0..span.1, msg);
+        let err =
+            |span: (usize, usize), msg: String| SceneError::at(path, text, span.0..span.1, msg);
         let mut numbers = |n: usize, what: &str| -> Result<Vec<f64>, SceneError> {
             let mut out = Vec::with_capacity(n);
             for _ in 0..n {
                 let Some((tok, span)) = tokens.next() else {
-                    return Err(err((start, start + content.trim_end().len()), format!("expected {n} numbers for {what}")));
+                    return Err(err(
+                        (start, start + content.trim_end().len()),
+                        format!("expected {n} numbers for {what}"),
+                    ));
                 };
                 match tok.parse::<f64>() {
                     Ok(v) if v.is_finite() => out.push(v),
-                    _ => return Err(err(span, format!("expected a finite number, found `{tok}`"))),
+                    _ => {
+                        return Err(err(
+                            span,
+                            format!("expected a finite number, found `{tok}`"),
+                        ))
+                    }
                 }
             }
             Ok(out)
@@ -59,11 +68,16 @@ pub fn parse_obj(path: &Path, text: &str) -> Result<TriangleMesh, SceneError> {
                 let mut corners = Vec::new();
                 for (tok, span) in tokens.by_ref() {
                     let mut parts = tok.split('/');
-                    let resolve = |s: Option<&str>, count: usize, what: &str| -> Result<u32, SceneError> {
+                    let resolve = |s: Option<&str>,
+                                   count: usize,
+                                   what: &str|
+                     -> Result<u32, SceneError> {
                         match s {
                             None | Some("") => Ok(u32::MAX),
                             Some(s) => {
-                                let i: i64 = s.parse().map_err(|_| err(span, format!("expected a {what} index, found `{s}`")))?;
+                                let i: i64 = s.parse().map_err(|_| {
+                                    err(span, format!("expected a {what} index, found `{s}`"))
+                                })?;
                                 let resolved = if i < 0 { count as i64 + i } else { i - 1 };
                                 if i == 0 || resolved < 0 || resolved >= count as i64 {
                                     return Err(err(span, format!("{what} index {i} is out of range: there are {count} so far")));
@@ -81,14 +95,25 @@ pub fn parse_obj(path: &Path, text: &str) -> Result<TriangleMesh, SceneError> {
                     let key = (p, t, n);
                     let index = *vertex_of.entry(key).or_insert_with(|| {
                         out_positions.push(positions[p as usize]);
-                        out_normals.push(if n == u32::MAX { Vec3::ZERO } else { normals[n as usize] });
-                        out_uvs.push(if t == u32::MAX { [0.0, 0.0] } else { uvs[t as usize] });
+                        out_normals.push(if n == u32::MAX {
+                            Vec3::ZERO
+                        } else {
+                            normals[n as usize]
+                        });
+                        out_uvs.push(if t == u32::MAX {
+                            [0.0, 0.0]
+                        } else {
+                            uvs[t as usize]
+                        });
                         (out_positions.len() - 1) as u32
                     });
                     corners.push(index);
                 }
                 if corners.len() < 3 {
-                    return Err(err((start, start + content.trim_end().len()), format!("a face needs at least 3 corners, found {}", corners.len())));
+                    return Err(err(
+                        (start, start + content.trim_end().len()),
+                        format!("a face needs at least 3 corners, found {}", corners.len()),
+                    ));
                 }
                 for i in 1..corners.len() - 1 {
                     triangles.push([corners[0], corners[i], corners[i + 1]]);
@@ -142,7 +167,8 @@ mod tests {
     fn errors_are_located() {
         let e = parse_obj(Path::new("bad.obj"), "v 0 0 0\nv 1 nan 0\n").unwrap_err();
         assert_eq!((e.line, e.column), (2, 5));
-        let e = parse_obj(Path::new("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap_err();
+        let e =
+            parse_obj(Path::new("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n").unwrap_err();
         assert_eq!((e.line, e.column), (4, 7));
         assert!(e.message.contains("out of range"), "{}", e.message);
     }

@@ -34,7 +34,10 @@ impl<'s> Source<'s> {
         let DeValue::Table(table) = value.get_ref() else {
             return Err(self.error(
                 value.span(),
-                format!("expected a table for {what}, found {}", describe(value.get_ref())),
+                format!(
+                    "expected a table for {what}, found {}",
+                    describe(value.get_ref())
+                ),
             ));
         };
         Fields::new(*self, table, value.span(), what, allowed)
@@ -42,7 +45,9 @@ impl<'s> Source<'s> {
 
     pub fn number(&self, v: &Value<'s>) -> Result<f64> {
         let n = match v.get_ref() {
-            DeValue::Integer(i) => i64::from_str_radix(i.as_str(), i.radix()).ok().map(|i| i as f64),
+            DeValue::Integer(i) => i64::from_str_radix(i.as_str(), i.radix())
+                .ok()
+                .map(|i| i as f64),
             DeValue::Float(f) => f.as_str().parse::<f64>().ok(),
             other => {
                 return Err(self.error(
@@ -175,8 +180,10 @@ impl<'a, 's> Fields<'a, 's> {
             let end = self.src.text[start..]
                 .find('\n')
                 .map_or(self.src.text.len(), |i| start + i);
-            self.src
-                .error(start..end, format!("missing field `{key}` in {}", self.what))
+            self.src.error(
+                start..end,
+                format!("missing field `{key}` in {}", self.what),
+            )
         })
     }
 

@@ -21,7 +21,13 @@ fn draw(loaded: &LoadedScene, spp: u32) -> plenum_core::film::Film {
         integrator: WhittedConfig::default(),
         seed: 1,
     };
-    render(&loaded.scene, &settings, &AtomicBool::new(false), &|_, _| {}).film
+    render(
+        &loaded.scene,
+        &settings,
+        &AtomicBool::new(false),
+        &|_, _| {},
+    )
+    .film
 }
 
 fn close(a: Color, b: Color, tol: f64) -> bool {
@@ -80,7 +86,10 @@ fn diffuse_sphere_matches_lambert_and_inverse_square() {
                 kd * (1.5 * cos * (1.0 / (dist * dist)).min(1.0))
             };
             let got = film.get(x, y);
-            assert!(close(got, expected, 1e-5), "pixel ({x}, {y}): {got:?} vs {expected:?}");
+            assert!(
+                close(got, expected, 1e-5),
+                "pixel ({x}, {y}): {got:?} vs {expected:?}"
+            );
         }
     }
     assert!(lit > 200, "the test must see a lit sphere");
@@ -118,7 +127,11 @@ material = "wall"
     for y in 0..16 {
         for x in 0..16 {
             let want = Color::new(0.2, 0.5, 0.7) * 0.9;
-            assert!(close(film.get(x, y), want, 1e-6), "({x}, {y}): {:?}", film.get(x, y));
+            assert!(
+                close(film.get(x, y), want, 1e-6),
+                "({x}, {y}): {:?}",
+                film.get(x, y)
+            );
         }
     }
 }
@@ -218,16 +231,33 @@ fn shadows_through_glass_are_coloured_by_k_t() {
     };
     let open = draw(&scene(SHADOW_SCENE), 1).get(4, 4);
     assert!(close(open, Color::gray(0.5 * cos), 1e-6), "{open:?}");
-    let glass = draw(&scene(&format!("{SHADOW_SCENE}{}", ball("[8, 5, 0]", "green_glass"))), 1).get(4, 4);
-    assert!(close(glass, Color::new(0.2, 0.8, 0.2) * (0.5 * cos), 1e-6), "{glass:?}");
+    let glass = draw(
+        &scene(&format!(
+            "{SHADOW_SCENE}{}",
+            ball("[8, 5, 0]", "green_glass")
+        )),
+        1,
+    )
+    .get(4, 4);
+    assert!(
+        close(glass, Color::new(0.2, 0.8, 0.2) * (0.5 * cos), 1e-6),
+        "{glass:?}"
+    );
     let two = format!(
         "{SHADOW_SCENE}{}{}",
         ball("[8, 5, 0]", "green_glass"),
         ball("[10.5, 7.5, 0]", "green_glass")
     );
     let twice = draw(&scene(&two), 1).get(4, 4);
-    assert!(close(twice, Color::new(0.04, 0.64, 0.04) * (0.5 * cos), 1e-6), "{twice:?}");
-    let opaque = draw(&scene(&format!("{SHADOW_SCENE}{}", ball("[8, 5, 0]", "opaque"))), 1).get(4, 4);
+    assert!(
+        close(twice, Color::new(0.04, 0.64, 0.04) * (0.5 * cos), 1e-6),
+        "{twice:?}"
+    );
+    let opaque = draw(
+        &scene(&format!("{SHADOW_SCENE}{}", ball("[8, 5, 0]", "opaque"))),
+        1,
+    )
+    .get(4, 4);
     assert_eq!(opaque, Color::BLACK);
 }
 
@@ -245,16 +275,27 @@ fn image_does_not_depend_on_thread_count() {
     let films: Vec<Vec<[f32; 3]>> = [1, 2, 3]
         .iter()
         .map(|&n| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .unwrap();
             pool.install(|| {
-                render(&loaded.scene, &settings, &AtomicBool::new(false), &|_, _| {})
-                    .film
-                    .pixels()
-                    .to_vec()
+                render(
+                    &loaded.scene,
+                    &settings,
+                    &AtomicBool::new(false),
+                    &|_, _| {},
+                )
+                .film
+                .pixels()
+                .to_vec()
             })
         })
         .collect();
-    assert!(films[0].iter().any(|p| p[0] > 0.1), "the image must not be black");
+    assert!(
+        films[0].iter().any(|p| p[0] > 0.1),
+        "the image must not be black"
+    );
     assert_eq!(films[0], films[1]);
     assert_eq!(films[0], films[2]);
 }

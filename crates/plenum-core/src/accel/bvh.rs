@@ -62,7 +62,9 @@ impl Bvh {
     }
 
     pub fn bounds(&self) -> Bounds3 {
-        self.nodes.first().map_or_else(Bounds3::default, |n| n.bounds)
+        self.nodes
+            .first()
+            .map_or_else(Bounds3::default, |n| n.bounds)
     }
 
     pub fn node_count(&self) -> usize {
@@ -115,7 +117,7 @@ impl Bvh {
         let (lo, hi) = (centroids.min[axis], centroids.max[axis]);
         if hi <= lo {
             // All centroids coincide: no split separates them.
-            return (n > MAX_LEAF).then(|| (axis, n / 2));
+            return (n > MAX_LEAF).then_some((axis, n / 2));
         }
         let bin_of = |c: Vec3| (((c[axis] - lo) / (hi - lo) * BINS as f64) as usize).min(BINS - 1);
         let mut bin_bounds = [Bounds3::default(); BINS];
@@ -275,7 +277,9 @@ mod tests {
         // A seeded cloud of spheres; compare with testing every sphere.
         let mut state = 12345u64;
         let mut next = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         let spheres: Vec<Sphere> = (0..500)

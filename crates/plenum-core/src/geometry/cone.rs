@@ -53,7 +53,10 @@ impl Cone {
                 part: SIDE,
             });
         if self.capped && d.z != 0.0 {
-            for (part, z, r) in [(BOTTOM, 0.0, self.radius0), (TOP, self.height, self.radius1)] {
+            for (part, z, r) in [
+                (BOTTOM, 0.0, self.radius0),
+                (TOP, self.height, self.radius1),
+            ] {
                 let t = (z - o.z) / d.z;
                 let limit = best.map_or(t_max, |h| h.t);
                 if t > 0.0 && t < limit {
@@ -72,7 +75,7 @@ impl Cone {
         best
     }
 
-    pub fn surface(&self, ray: &Ray, hit: &HitRecord) -> SurfaceGeometry {
+    pub fn surface(&self, ray: &Ray, hit: &HitRecord, want_uv: bool) -> SurfaceGeometry {
         let p = ray.at(hit.t);
         if hit.part == SIDE {
             // Re-project radially onto the side at this height.
@@ -87,10 +90,14 @@ impl Cone {
             let p = Vec3::new(x, y, z);
             // ∇(x² + y² − (r₀ + k·z)²) ∝ (x, y, −k·r(z)).
             let n = Vec3::new(x, y, -self.slope() * r).normalized();
-            let phi = y.atan2(x);
-            let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
+            let u = if want_uv {
+                let phi = y.atan2(x);
+                (if phi < 0.0 { phi + 2.0 * PI } else { phi }) / (2.0 * PI)
+            } else {
+                0.0
+            };
             let err = (p.abs() + Vec3::splat(r)) * gamma(8);
-            SurfaceGeometry::flat(p, err, n, [phi / (2.0 * PI), z / self.height])
+            SurfaceGeometry::flat(p, err, n, [u, z / self.height])
         } else {
             let (z, n) = if hit.part == BOTTOM {
                 (0.0, -Vec3::Z)
@@ -125,7 +132,7 @@ mod tests {
         let ray = Ray::new(Vec3::new(-5.0, 0.0, 0.5), Vec3::X);
         let hit = cone.intersect(&ray, 1e9).unwrap();
         assert!((hit.t - 4.5).abs() < 1e-12);
-        let g = cone.surface(&ray, &hit);
+        let g = cone.surface(&ray, &hit, true);
         let s = 0.5f64.sqrt();
         assert!((g.n - Vec3::new(-s, 0.0, s)).length() < 1e-12, "{:?}", g.n);
     }
@@ -144,6 +151,6 @@ mod tests {
         cone.capped = true;
         let hit = cone.intersect(&ray, 1e9).unwrap();
         assert!((hit.t - 3.0).abs() < 1e-12);
-        assert_eq!(cone.surface(&ray, &hit).n, Vec3::Z);
+        assert_eq!(cone.surface(&ray, &hit, true).n, Vec3::Z);
     }
 }

@@ -65,7 +65,11 @@ impl Cuboid {
         let max_side = hit.part % 2 == 1;
         let mut c = ray.at(hit.t).to_array();
         // Snap onto the face: the coordinate along the normal becomes exact.
-        c[axis] = if max_side { self.max[axis] } else { self.min[axis] };
+        c[axis] = if max_side {
+            self.max[axis]
+        } else {
+            self.min[axis]
+        };
         let p = Vec3::from_array(c);
         let mut n = [0.0; 3];
         n[axis] = if max_side { 1.0 } else { -1.0 };

@@ -33,8 +33,8 @@ impl Cylinder {
         self.shape.intersect(ray, t_max)
     }
 
-    pub fn surface(&self, ray: &Ray, hit: &HitRecord) -> SurfaceGeometry {
-        self.shape.surface(ray, hit)
+    pub fn surface(&self, ray: &Ray, hit: &HitRecord, want_uv: bool) -> SurfaceGeometry {
+        self.shape.surface(ray, hit, want_uv)
     }
 }
 
@@ -50,7 +50,7 @@ mod tests {
         let hit = c.intersect(&ray, 1e9).unwrap();
         // x = −√(4 − 1)
         assert!((hit.t - (10.0 - 3f64.sqrt())).abs() < 1e-12);
-        let g = c.surface(&ray, &hit);
+        let g = c.surface(&ray, &hit, true);
         assert!((g.n - Vec3::new(-(3f64.sqrt()) / 2.0, 0.5, 0.0)).length() < 1e-12);
         // Above the top the open cylinder is missed.
         assert!(c

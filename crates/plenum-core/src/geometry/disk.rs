@@ -49,14 +49,18 @@ impl Disk {
         })
     }
 
-    pub fn surface(&self, ray: &Ray, hit: &HitRecord) -> SurfaceGeometry {
+    pub fn surface(&self, ray: &Ray, hit: &HitRecord, want_uv: bool) -> SurfaceGeometry {
         let (p, p_error) =
             project_onto_plane(ray, hit.t, self.normal, self.normal.dot(self.center));
         let d = p - self.center;
         let (x, y) = (d.dot(self.tangent_s), d.dot(self.tangent_t));
-        let phi = y.atan2(x);
-        let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
-        let uv = [phi / (2.0 * PI), (x * x + y * y).sqrt() / self.radius];
+        let uv = if want_uv {
+            let phi = y.atan2(x);
+            let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
+            [phi / (2.0 * PI), (x * x + y * y).sqrt() / self.radius]
+        } else {
+            [0.0, 0.0]
+        };
         SurfaceGeometry::flat(p, p_error, self.normal, uv)
     }
 }

@@ -21,9 +21,17 @@ pub struct TriangleMesh {
 #[derive(Clone, Debug, PartialEq)]
 pub enum MeshError {
     NoTriangles,
-    IndexOutOfRange { triangle: usize, index: u32, vertices: usize },
+    IndexOutOfRange {
+        triangle: usize,
+        index: u32,
+        vertices: usize,
+    },
     NonFinitePosition(usize),
-    CountMismatch { what: &'static str, found: usize, vertices: usize },
+    CountMismatch {
+        what: &'static str,
+        found: usize,
+        vertices: usize,
+    },
 }
 
 impl std::fmt::Display for MeshError {
@@ -166,7 +174,11 @@ fn difference_of_products(a: f64, b: f64, c: f64, d: f64) -> f64 {
 }
 
 /// The watertight test. Returns (t, b1, b2) with the hit at b0·p0 + b1·p1 + b2·p2.
-pub fn intersect_triangle(ray: &Ray, t_max: f64, [p0, p1, p2]: [Vec3; 3]) -> Option<(f64, f64, f64)> {
+pub fn intersect_triangle(
+    ray: &Ray,
+    t_max: f64,
+    [p0, p1, p2]: [Vec3; 3],
+) -> Option<(f64, f64, f64)> {
     // Translate to the ray origin, permute so z is the direction's largest axis, then shear
     // so the ray runs along +z: the test becomes a 2-D edge-function test at the origin.
     let d = ray.direction;

@@ -101,14 +101,16 @@ impl Shape {
         }
     }
 
-    pub fn surface(&self, ray: &Ray, hit: &HitRecord) -> SurfaceGeometry {
+    /// The geometry at a hit. Texture coordinates cost trigonometry on curved shapes, so
+    /// they are computed only when `want_uv` is set (otherwise they may be zero).
+    pub fn surface(&self, ray: &Ray, hit: &HitRecord, want_uv: bool) -> SurfaceGeometry {
         match self {
-            Shape::Sphere(s) => s.surface(ray, hit),
+            Shape::Sphere(s) => s.surface(ray, hit, want_uv),
             Shape::Plane(s) => s.surface(ray, hit),
-            Shape::Disk(s) => s.surface(ray, hit),
+            Shape::Disk(s) => s.surface(ray, hit, want_uv),
             Shape::Cuboid(s) => s.surface(ray, hit),
-            Shape::Cylinder(s) => s.surface(ray, hit),
-            Shape::Cone(s) => s.surface(ray, hit),
+            Shape::Cylinder(s) => s.surface(ray, hit, want_uv),
+            Shape::Cone(s) => s.surface(ray, hit, want_uv),
             Shape::Polygon(s) => s.surface(ray, hit),
             Shape::Polyhedron(s) => s.surface(ray, hit),
             Shape::Mesh(s) => s.surface(ray, hit),

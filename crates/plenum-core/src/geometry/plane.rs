@@ -61,7 +61,11 @@ mod tests {
         let g = plane.surface(&ray, &hit);
         assert_eq!(g.n, Vec3::Y);
         assert!((g.p - Vec3::new(0.0, -1.0, 1.0)).length() < 1e-15);
-        assert!(plane.intersect(&Ray::new(Vec3::ZERO, Vec3::X), 1e9).is_none());
-        assert!(plane.intersect(&Ray::new(Vec3::ZERO, Vec3::Y), 1e9).is_none());
+        assert!(plane
+            .intersect(&Ray::new(Vec3::ZERO, Vec3::X), 1e9)
+            .is_none());
+        assert!(plane
+            .intersect(&Ray::new(Vec3::ZERO, Vec3::Y), 1e9)
+            .is_none());
     }
 }

@@ -57,10 +57,7 @@ impl Polyhedron {
             .map(|f| f.iter().map(|&i| vertices[i as usize]).collect())
             .collect();
         // Signed volume by the divergence theorem: negative means inward-facing normals.
-        let volume: f64 = loops
-            .iter()
-            .map(|l| l[0].dot(newell_normal(l)) / 6.0)
-            .sum();
+        let volume: f64 = loops.iter().map(|l| l[0].dot(newell_normal(l)) / 6.0).sum();
         let faces = loops
             .into_iter()
             .enumerate()

@@ -55,16 +55,20 @@ impl Sphere {
         })
     }
 
-    pub fn surface(&self, ray: &Ray, hit: &HitRecord) -> SurfaceGeometry {
+    pub fn surface(&self, ray: &Ray, hit: &HitRecord, want_uv: bool) -> SurfaceGeometry {
         // Re-project onto the sphere: removes the error of t (pbrt-v4 §6.8.5).
         let offset = ray.at(hit.t) - self.center;
         let offset = offset * (self.radius / offset.length());
         let p = self.center + offset;
         let p_error = (offset.abs() + self.center.abs()) * gamma(8);
         let n = offset / self.radius;
-        let phi = n.y.atan2(n.x);
-        let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
-        let uv = [phi / (2.0 * PI), n.z.clamp(-1.0, 1.0).acos() / PI];
+        let uv = if want_uv {
+            let phi = n.y.atan2(n.x);
+            let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
+            [phi / (2.0 * PI), n.z.clamp(-1.0, 1.0).acos() / PI]
+        } else {
+            [0.0, 0.0]
+        };
         SurfaceGeometry::flat(p, p_error, n, uv)
     }
 }
@@ -81,21 +85,25 @@ mod tests {
         let hit = s.intersect(&ray, f64::INFINITY).unwrap();
         // z = 5 − √(4 − 1)
         assert!((hit.t - (5.0 - 3f64.sqrt())).abs() < 1e-12);
-        let g = s.surface(&ray, &hit);
+        let g = s.surface(&ray, &hit, true);
         assert_close(g.n, Vec3::new(0.5, 0.0, -(3f64.sqrt()) / 2.0), 1e-12);
     }
 
     #[test]
     fn ray_from_inside_hits_the_far_side() {
         let s = Sphere::new(Vec3::ZERO, 1.0);
-        let hit = s.intersect(&Ray::new(Vec3::ZERO, Vec3::X), f64::INFINITY).unwrap();
+        let hit = s
+            .intersect(&Ray::new(Vec3::ZERO, Vec3::X), f64::INFINITY)
+            .unwrap();
         assert!((hit.t - 1.0).abs() < 1e-15);
     }
 
     #[test]
     fn misses_and_respects_t_max() {
         let s = Sphere::new(Vec3::new(0.0, 0.0, 5.0), 1.0);
-        assert!(s.intersect(&Ray::new(Vec3::new(2.0, 0.0, 0.0), Vec3::Z), 1e9).is_none());
+        assert!(s
+            .intersect(&Ray::new(Vec3::new(2.0, 0.0, 0.0), Vec3::Z), 1e9)
+            .is_none());
         assert!(s.intersect(&Ray::new(Vec3::ZERO, Vec3::Z), 3.0).is_none());
         assert!(s.intersect(&Ray::new(Vec3::ZERO, -Vec3::Z), 1e9).is_none());
     }
@@ -111,7 +119,7 @@ mod tests {
         let hit = s.intersect(&ray, f64::INFINITY).unwrap();
         let exact = 1e7 - (r * r - x * x).sqrt();
         assert!((hit.t - exact).abs() < 1e-6, "{} vs {exact}", hit.t);
-        let g = s.surface(&ray, &hit);
+        let g = s.surface(&ray, &hit, true);
         assert!(((g.p - s.center).length() - r).abs() < 1e-8);
     }
 }

@@ -78,7 +78,12 @@ impl<'a> Whitted<'a> {
     }
 
     /// Radiance along a camera ray. With `tree`, every ray traced is recorded in it.
-    pub fn camera_ray(&self, ray: &Ray, counts: &mut RayCounts, tree: Option<&mut RayTree>) -> Color {
+    pub fn camera_ray(
+        &self,
+        ray: &Ray,
+        counts: &mut RayCounts,
+        tree: Option<&mut RayTree>,
+    ) -> Color {
         counts.camera += 1;
         let branch = Branch {
             kind: RayKind::Camera,
@@ -242,7 +247,11 @@ impl<'a> Whitted<'a> {
             Some(light_at) => Ray::new(origin, light_at - origin),
             None => Ray::new(origin, inc.wi),
         };
-        let t_max = if inc.position.is_some() { SHADOW_END } else { f64::INFINITY };
+        let t_max = if inc.position.is_some() {
+            SHADOW_END
+        } else {
+            f64::INFINITY
+        };
         let recording = b.tree.is_some();
         let mut occluders: Vec<(f64, u32)> = Vec::new();
         let mut s = Color::WHITE;
@@ -262,7 +271,14 @@ impl<'a> Whitted<'a> {
         });
         if let Some(t) = b.tree.as_deref_mut() {
             occluders.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let mut node = RayNode::new(parent, RayKind::Shadow, b.depth + 1, origin, inc.wi, b.weight);
+            let mut node = RayNode::new(
+                parent,
+                RayKind::Shadow,
+                b.depth + 1,
+                origin,
+                inc.wi,
+                b.weight,
+            );
             node.distance = Some(inc.distance);
             node.color = s * inc.intensity;
             node.shadow = Some(ShadowInfo {

@@ -143,9 +143,24 @@ impl Transform {
         let (s, c) = degrees.to_radians().sin_cos();
         let t = 1.0 - c;
         let m = Matrix4([
-            [t * a.x * a.x + c, t * a.x * a.y - s * a.z, t * a.x * a.z + s * a.y, 0.0],
-            [t * a.x * a.y + s * a.z, t * a.y * a.y + c, t * a.y * a.z - s * a.x, 0.0],
-            [t * a.x * a.z - s * a.y, t * a.y * a.z + s * a.x, t * a.z * a.z + c, 0.0],
+            [
+                t * a.x * a.x + c,
+                t * a.x * a.y - s * a.z,
+                t * a.x * a.z + s * a.y,
+                0.0,
+            ],
+            [
+                t * a.x * a.y + s * a.z,
+                t * a.y * a.y + c,
+                t * a.y * a.z - s * a.x,
+                0.0,
+            ],
+            [
+                t * a.x * a.z - s * a.y,
+                t * a.y * a.z + s * a.x,
+                t * a.z * a.z + c,
+                0.0,
+            ],
             [0.0, 0.0, 0.0, 1.0],
         ]);
         Some(Transform {

@@ -3,8 +3,8 @@
 //! **Invariant:** a sample's random numbers derive from (seed, pixel, sample index) alone,
 //! never from the thread that computes it, so images do not depend on the thread count.
 
-mod rng;
 mod pixel;
+mod rng;
 
 pub use pixel::PixelSampler;
 pub use rng::Rng;

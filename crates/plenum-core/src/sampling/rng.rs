@@ -23,7 +23,10 @@ impl Rng {
     /// The generator for one pixel sample: a hash of everything that identifies it.
     pub fn for_sample(seed: u64, x: u32, y: u32, index: u32) -> Rng {
         let pixel = ((y as u64) << 32) | x as u64;
-        Rng::new(mix(seed ^ mix(pixel)), mix(index as u64 ^ seed.rotate_left(17)))
+        Rng::new(
+            mix(seed ^ mix(pixel)),
+            mix(index as u64 ^ seed.rotate_left(17)),
+        )
     }
 
     pub fn next_u32(&mut self) -> u32 {
