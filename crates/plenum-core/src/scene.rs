@@ -131,6 +131,8 @@ pub struct Scene {
     /// Radiance of rays that hit nothing.
     pub background: Color,
     bvh: Bvh,
+    /// Primitive index of each BVH item: the BVH holds the bounded primitives only.
+    bounded: Vec<u32>,
     /// Primitives without bounds (infinite planes), tested on every ray.
     unbounded: Vec<u32>,
 }
@@ -139,10 +141,10 @@ impl Scene {
     /// The nearest hit in (0, t_max): the primitive's index and the hit.
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<(u32, HitRecord)> {
         let mut best = self.bvh.intersect(ray, t_max, |i, t| {
-            self.primitives[self.bounded_index(i)].intersect(ray, t)
+            self.primitives[self.bounded[i as usize] as usize].intersect(ray, t)
         });
         if let Some((i, _)) = &mut best {
-            *i = self.bounded_index(*i) as u32;
+            *i = self.bounded[*i as usize];
         }
         for &i in &self.unbounded {
             let limit = best.map_or(t_max, |(_, h)| h.t);
@@ -163,9 +165,9 @@ impl Scene {
     ) {
         let mut go_on = true;
         self.bvh.for_each_candidate(ray, t_max, |i| {
-            let prim = self.bounded_index(i);
-            if let Some(hit) = self.primitives[prim].intersect(ray, t_max) {
-                go_on = visit(prim as u32, &hit);
+            let prim = self.bounded[i as usize];
+            if let Some(hit) = self.primitives[prim as usize].intersect(ray, t_max) {
+                go_on = visit(prim, &hit);
             }
             go_on
         });
@@ -177,19 +179,6 @@ impl Scene {
                 go_on = visit(i, &hit);
             }
         }
-    }
-
-    /// The BVH is built over bounded primitives in their original order, skipping planes.
-    fn bounded_index(&self, bvh_item: u32) -> usize {
-        // Unbounded primitives are few; counting those before the item keeps the mapping
-        // without a second table.
-        let mut index = bvh_item as usize;
-        for &u in &self.unbounded {
-            if (u as usize) <= index {
-                index += 1;
-            }
-        }
-        index
     }
 
     pub fn interaction(&self, ray: &Ray, primitive: u32, hit: &HitRecord) -> Interaction {
@@ -257,16 +246,21 @@ impl SceneBuilder {
             }
         }
         let mut bounds = Vec::new();
+        let mut bounded = Vec::new();
         let mut unbounded = Vec::new();
         for (i, p) in self.primitives.iter().enumerate() {
             match p.world_bounds() {
-                Some(b) => bounds.push(b),
+                Some(b) => {
+                    bounds.push(b);
+                    bounded.push(i as u32);
+                }
                 None => unbounded.push(i as u32),
             }
         }
         Scene {
             camera: self.camera,
             bvh: Bvh::build(&bounds),
+            bounded,
             unbounded,
             primitives: self.primitives,
             object_names: self.object_names,
