@@ -1,0 +1,194 @@
+//! Scene features end to end: image textures, OBJ files beside the scene, instancing, and
+//! refraction between nested media.
+
+use plenum_core::geometry::Shape;
+use plenum_core::integrator::RayKind;
+use plenum_core::render::{render, trace_pixel, RenderSettings};
+use plenum_core::sampling::PixelSampler;
+use plenum_core::{Color, Vec3};
+use plenum_scene::{load_scene, parse_scene, LoadedScene};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("plenum-scene-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn settings(l: &LoadedScene) -> RenderSettings {
+    RenderSettings {
+        width: l.defaults.width,
+        height: l.defaults.height,
+        sampler: PixelSampler::grid_for(1),
+        ..Default::default()
+    }
+}
+
+/// A 2×2 PNG texture on a square that exactly fills a 2×2 image: each pixel shows its
+/// texel, decoded from sRGB to linear.
+#[test]
+fn image_texture_is_read_relative_to_the_scene_and_decoded_to_linear() {
+    let dir = temp_dir("texture");
+    let texels = [
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.2, 0.2, 0.2],
+    ];
+    plenum_image::write_image(&dir.join("tex.png"), 2, 2, &texels, 0.0).unwrap();
+    std::fs::write(
+        dir.join("scene.toml"),
+        r#"
+[camera]
+position = [0.5, 0.5, 1]
+look_at = [0.5, 0.5, 0]
+fov = 53.13010235415598
+resolution = [2, 2]
+[materials.picture]
+diffuse = 0
+emissive = { texture = "image", file = "tex.png" }
+[[objects]]
+type = "polygon"
+material = "picture"
+vertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+"#,
+    )
+    .unwrap();
+    let loaded = load_scene(&dir.join("scene.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let film = render(
+        &loaded.scene,
+        &settings(&loaded),
+        &AtomicBool::new(false),
+        &|_, _| {},
+    )
+    .film;
+    // One pixel per texel: each pixel centre is a texel centre, where bilinear
+    // interpolation returns the texel itself. Top-left is texel 0.
+    let at = |x, y| film.get(x, y);
+    let near = |c: Color, t: [f32; 3]| {
+        (c.r - t[0] as f64).abs() < 0.01
+            && (c.g - t[1] as f64).abs() < 0.01
+            && (c.b - t[2] as f64).abs() < 0.01
+    };
+    assert!(near(at(0, 0), texels[0]), "{:?}", at(0, 0));
+    assert!(near(at(1, 0), texels[1]), "{:?}", at(1, 0));
+    assert!(near(at(0, 1), texels[2]), "{:?}", at(0, 1));
+    // 0.2 linear survives the 8-bit sRGB round trip to within a percent.
+    assert!(near(at(1, 1), texels[3]), "{:?}", at(1, 1));
+}
+
+#[test]
+fn obj_meshes_load_beside_the_scene_and_instances_share_them() {
+    let dir = temp_dir("instances");
+    std::fs::write(
+        dir.join("tri.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nf 1//1 2//2 3//3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("scene.toml"),
+        r#"
+[meshes.tri]
+file = "tri.obj"
+[[objects]]
+type = "mesh"
+mesh = "tri"
+[[objects]]
+type = "mesh"
+mesh = "tri"
+transform = [{ translate = [2, 0, 0] }]
+[[objects]]
+type = "mesh"
+mesh = "tri"
+transform = [{ rotate = { axis = [0, 0, 1], degrees = 90 } }, { scale = 3 }]
+"#,
+    )
+    .unwrap();
+    let loaded = load_scene(&dir.join("scene.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let meshes: Vec<_> = loaded
+        .scene
+        .primitives
+        .iter()
+        .map(|p| match &p.shape {
+            Shape::Mesh(m) => m.clone(),
+            _ => panic!("expected meshes"),
+        })
+        .collect();
+    assert_eq!(meshes.len(), 3);
+    assert!(std::sync::Arc::ptr_eq(&meshes[0], &meshes[1]));
+    assert!(std::sync::Arc::ptr_eq(&meshes[0], &meshes[2]));
+    // Bounds: the third copy is rotated 90° and scaled by 3.
+    let b = loaded.scene.bounds();
+    assert!(
+        (b.min.x + 3.0).abs() < 1e-9 && (b.max.x - 3.0).abs() < 1e-9,
+        "{b:?}"
+    );
+}
+
+/// A ray through a glass ball holding a water ball: at every interface the refracted ray
+/// obeys Snell's law with the indices of the media on either side (glass inside glass).
+#[test]
+fn nested_media_refract_with_the_right_index_pairs() {
+    let loaded = parse_scene(
+        Path::new("nested.toml"),
+        r#"
+[camera]
+position = [0, 0, 10]
+look_at = [0, 0, 0]
+fov = 30
+resolution = [41, 41]
+[materials.glass]
+diffuse = 0
+transmissive = 1
+ior = 1.5
+[materials.water]
+diffuse = 0
+transmissive = 1
+ior = 1.33
+[[objects]]
+type = "sphere"
+name = "glass"
+radius = 2
+material = "glass"
+[[objects]]
+type = "sphere"
+name = "water"
+radius = 1.2
+material = "water"
+"#,
+        Path::new("."),
+    )
+    .unwrap();
+    // A pixel right of centre whose ray crosses both balls off-axis.
+    let (tree, _) = trace_pixel(&loaded.scene, &settings(&loaded), 23, 20);
+    let chain: Vec<_> = tree
+        .nodes
+        .iter()
+        .filter(|n| matches!(n.kind, RayKind::Camera | RayKind::Refracted))
+        .collect();
+    let names: Vec<_> = chain
+        .iter()
+        .map(|n| n.object.clone().unwrap_or_default())
+        .collect();
+    assert_eq!(
+        names,
+        ["glass", "water", "water", "glass", ""],
+        "path through the balls"
+    );
+    let radius = |name: &str| if name == "glass" { 2.0 } else { 1.2 };
+    let pairs = [(1.0, 1.5), (1.5, 1.33), (1.33, 1.5), (1.5, 1.0)];
+    for (i, &(eta_i, eta_t)) in pairs.iter().enumerate() {
+        let (incoming, outgoing) = (chain[i], chain[i + 1]);
+        let p = outgoing.origin;
+        let n = p / radius(&names[i]);
+        assert!((p.length() - radius(&names[i])).abs() < 1e-9);
+        let sin = |d: Vec3| d.cross(n).length();
+        let (si, st) = (sin(incoming.direction), sin(outgoing.direction));
+        assert!(si > 0.05, "the test needs oblique incidence");
+        assert!(
+            (eta_i * si - eta_t * st).abs() < 1e-9,
+            "interface {i}: {eta_i}·{si} ≠ {eta_t}·{st}"
+        );
+    }
+}
