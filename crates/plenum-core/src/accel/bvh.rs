@@ -165,11 +165,31 @@ impl Bvh {
     pub fn intersect(
         &self,
         ray: &Ray,
-        mut t_max: f64,
+        t_max: f64,
         mut hit_item: impl FnMut(u32, f64) -> Option<HitRecord>,
     ) -> Option<(u32, HitRecord)> {
+        let mut best = None;
+        self.traverse(ray, t_max, |item, t_max| {
+            if let Some(hit) = hit_item(item, *t_max) {
+                *t_max = hit.t;
+                best = Some((item, hit));
+            }
+            true
+        });
+        best
+    }
+
+    /// Calls `visit(item)` for every item in a leaf whose box the ray crosses in (0, t_max),
+    /// until `visit` returns false. For queries that want every hit, not the nearest one.
+    pub fn for_each_candidate(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(u32) -> bool) {
+        self.traverse(ray, t_max, |item, _| visit(item));
+    }
+
+    /// Front-to-back traversal with a fixed-size stack. `visit(item, t_max)` may shrink
+    /// `t_max` to prune farther nodes, and returns false to stop.
+    fn traverse(&self, ray: &Ray, mut t_max: f64, mut visit: impl FnMut(u32, &mut f64) -> bool) {
         if self.nodes.is_empty() {
-            return None;
+            return;
         }
         let inv_dir = Vec3::new(
             1.0 / ray.direction.x,
@@ -180,16 +200,14 @@ impl Bvh {
         let mut stack = [0u32; MAX_DEPTH];
         let mut top = 0;
         let mut current = 0usize;
-        let mut best = None;
         loop {
             let node = &self.nodes[current];
             if node.bounds.intersect(ray, inv_dir, t_max).is_some() {
                 if node.count > 0 {
                     let start = node.offset as usize;
                     for &item in &self.order[start..start + node.count as usize] {
-                        if let Some(hit) = hit_item(item, t_max) {
-                            t_max = hit.t;
-                            best = Some((item, hit));
+                        if !visit(item, &mut t_max) {
+                            return;
                         }
                     }
                 } else {
@@ -202,47 +220,6 @@ impl Bvh {
                     stack[top] = second as u32;
                     top += 1;
                     current = first;
-                    continue;
-                }
-            }
-            if top == 0 {
-                return best;
-            }
-            top -= 1;
-            current = stack[top] as usize;
-        }
-    }
-}
-
-impl Bvh {
-    /// Calls `visit(item)` for every item in a leaf whose box the ray crosses in (0, t_max),
-    /// until `visit` returns false. For queries that want every hit, not the nearest one.
-    pub fn for_each_candidate(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(u32) -> bool) {
-        if self.nodes.is_empty() {
-            return;
-        }
-        let inv_dir = Vec3::new(
-            1.0 / ray.direction.x,
-            1.0 / ray.direction.y,
-            1.0 / ray.direction.z,
-        );
-        let mut stack = [0u32; MAX_DEPTH];
-        let mut top = 0;
-        let mut current = 0usize;
-        loop {
-            let node = &self.nodes[current];
-            if node.bounds.intersect(ray, inv_dir, t_max).is_some() {
-                if node.count > 0 {
-                    let start = node.offset as usize;
-                    for &item in &self.order[start..start + node.count as usize] {
-                        if !visit(item) {
-                            return;
-                        }
-                    }
-                } else {
-                    stack[top] = node.offset;
-                    top += 1;
-                    current += 1;
                     continue;
                 }
             }
