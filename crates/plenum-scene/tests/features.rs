@@ -192,3 +192,59 @@ material = "water"
         );
     }
 }
+
+/// From inside a glass slab, a ray beyond the critical angle (41.8° for η = 1.5) is totally
+/// reflected and the refracted weight goes to the reflected ray; below it, it refracts out.
+#[test]
+fn total_internal_reflection_moves_the_refracted_weight_to_reflection() {
+    let slab = |look_at: &str| {
+        parse_scene(
+            Path::new("slab.toml"),
+            &format!(
+                r#"
+[camera]
+position = [0, 0, 0]
+look_at = {look_at}
+up = [0, 0, 1]
+resolution = [3, 3]
+[materials.glass]
+diffuse = 0
+transmissive = 0.8
+reflective = 0.1
+ior = 1.5
+[[objects]]
+type = "box"
+name = "slab"
+min = [-100, -1, -100]
+max = [100, 1, 100]
+material = "glass"
+"#
+            ),
+            Path::new("."),
+        )
+        .unwrap()
+    };
+    let children = |tree: &plenum_core::integrator::RayTree, kind| {
+        tree.children(0)
+            .filter(|&c| tree.nodes[c].kind == kind)
+            .count()
+    };
+    // 84° from the normal: beyond the critical angle.
+    let grazing = slab("[10, 1, 0]");
+    let (tree, _) = trace_pixel(&grazing.scene, &settings(&grazing), 1, 1);
+    assert!(tree.nodes[0].total_internal_reflection);
+    assert_eq!(children(&tree, RayKind::Refracted), 0);
+    let reflected = tree
+        .children(0)
+        .find(|&c| tree.nodes[c].kind == RayKind::Reflected)
+        .unwrap();
+    assert!(
+        (tree.nodes[reflected].weight.r - 0.9).abs() < 1e-12,
+        "k_r + k_t"
+    );
+    // 5.7° from the normal: it leaves the glass.
+    let steep = slab("[0.1, 1, 0]");
+    let (tree, _) = trace_pixel(&steep.scene, &settings(&steep), 1, 1);
+    assert!(!tree.nodes[0].total_internal_reflection);
+    assert_eq!(children(&tree, RayKind::Refracted), 1);
+}
