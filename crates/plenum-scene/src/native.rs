@@ -279,10 +279,12 @@ impl<'s> Reader<'s> {
         let fresnel = f.bool_or("fresnel", d.fresnel)?;
         // With Fresnel weighting, k_r is a tint: white unless given.
         let reflective_default = if fresnel { Color::WHITE } else { Color::BLACK };
+        let diffuse = tex("diffuse", d.diffuse.clone())?;
         let m = Material {
             emissive: tex("emissive", d.emissive.clone())?,
-            ambient: tex("ambient", d.ambient.clone())?,
-            diffuse: tex("diffuse", d.diffuse.clone())?,
+            // Ambient light lights a surface in its own colour unless told otherwise.
+            ambient: tex("ambient", diffuse.clone())?,
+            diffuse,
             specular: tex("specular", d.specular.clone())?,
             shininess: match f.get("shininess") {
                 None => d.shininess,

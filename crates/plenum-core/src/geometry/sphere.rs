@@ -62,10 +62,11 @@ impl Sphere {
         let p = self.center + offset;
         let p_error = (offset.abs() + self.center.abs()) * gamma(8);
         let n = offset / self.radius;
+        // Poles on the y axis, the scene's up: u runs around it, v from the top (0) down.
         let uv = if want_uv {
-            let phi = n.y.atan2(n.x);
+            let phi = n.x.atan2(n.z);
             let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
-            [phi / (2.0 * PI), n.z.clamp(-1.0, 1.0).acos() / PI]
+            [phi / (2.0 * PI), n.y.clamp(-1.0, 1.0).acos() / PI]
         } else {
             [0.0, 0.0]
         };
