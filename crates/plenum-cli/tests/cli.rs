@@ -152,6 +152,17 @@ fn bad_scenes_give_located_errors() {
         ),
         ("[camera\nfov = 3\n", "1:", "error"),
         (
+            "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nintensity = -1\n",
+            "4:13",
+            "expected intensity ≥ 0",
+        ),
+        ("[render]\nspp = 0\n", "2:7", "expected at least 1 sample"),
+        (
+            "[meshes.m]\npositions = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\nindices = [[0, 1, 2]]\n[[objects]]\ntype = \"mesh\"\nmesh = \"m\"\nfile = \"m.obj\"\n",
+            "7:8",
+            "give only one of mesh, file, positions",
+        ),
+        (
             "[[objects]]\ntype = \"spere\"\n",
             "2:8",
             "did you mean `sphere`?",

@@ -136,21 +136,28 @@ pub struct Texels {
     pub rgb: Vec<[f32; 3]>,
 }
 
-/// Reads a PNG or JPEG texture and converts its sRGB values to linear.
+/// Reads a texture: PNG or JPEG, whose 8- or 16-bit values are sRGB-encoded and decoded to
+/// linear here; EXR and HDR, whose float values are linear already.
 pub fn read_texture(path: &Path) -> Result<Texels, ImageError> {
     let img = image::open(path).map_err(|e| ImageError::Read {
         path: path.display().to_string(),
         source: e.into(),
     })?;
-    let rgb = img.to_rgb8();
-    let (w, h) = rgb.dimensions();
-    Ok(Texels {
-        width: w as usize,
-        height: h as usize,
-        rgb: rgb
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let rgb = match img {
+        image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_) => {
+            img.to_rgb32f().pixels().map(|p| p.0).collect()
+        }
+        _ => img
+            .to_rgb32f()
             .pixels()
-            .map(|p| p.0.map(|c| srgb_decode(c as f32 / 255.0)))
+            .map(|p| p.0.map(srgb_decode))
             .collect(),
+    };
+    Ok(Texels {
+        width: w,
+        height: h,
+        rgb,
     })
 }
 

@@ -116,12 +116,18 @@ impl<'s> Reader<'s> {
             &["spp", "max_depth", "min_weight", "exposure"],
         )?;
         if let Some(spp) = f.count("spp")? {
-            d.spp = spp.max(1);
+            if spp == 0 {
+                return Err(self.src.error(
+                    f.required("spp")?.span(),
+                    "expected at least 1 sample per pixel",
+                ));
+            }
+            d.spp = spp;
         }
         if let Some(depth) = f.count("max_depth")? {
             d.max_depth = depth;
         }
-        d.min_weight = f.number_or("min_weight", d.min_weight)?;
+        d.min_weight = f.non_negative_or("min_weight", d.min_weight)?;
         d.exposure = f.number_or("exposure", d.exposure)?;
         Ok(())
     }
@@ -237,7 +243,13 @@ impl<'s> Reader<'s> {
                     .map_err(|e| self.src.error(file.span(), e.to_string()))?;
                 let scale = match f.get("scale") {
                     None => [1.0, 1.0],
-                    Some(s) => self.src.numbers::<2>(s, "[u, v] repeats")?,
+                    Some(s) => {
+                        let r = self.src.numbers::<2>(s, "[u, v] repeats")?;
+                        if r[0] <= 0.0 || r[1] <= 0.0 {
+                            return Err(self.src.error(s.span(), "expected repeats > 0"));
+                        }
+                        r
+                    }
                 };
                 let (width, height) = (texels.width, texels.height);
                 let texels = texels
@@ -317,7 +329,7 @@ impl<'s> Reader<'s> {
         };
         let intensity = |f: &Fields| -> Result<Color> {
             let c = f.get("color").map_or(Ok(Color::WHITE), |c| self.color(c))?;
-            Ok(c * f.number_or("intensity", 1.0)?)
+            Ok(c * f.non_negative_or("intensity", 1.0)?)
         };
         match kind.as_str() {
             "point" => {
@@ -607,6 +619,7 @@ impl<'s> Reader<'s> {
                 ))
             }
             _ => {
+                f.one_of(&["mesh", "file", "positions"])?;
                 if let Some(m) = f.get("mesh") {
                     let name = src.string(m)?;
                     let Some(mesh) = self.meshes.get(name) else {
@@ -638,6 +651,7 @@ impl<'s> Reader<'s> {
     /// A mesh from `file` (OBJ) or from inline `positions` and `indices`.
     fn mesh_data(&self, f: &Fields<'_, 's>) -> Result<Arc<TriangleMesh>> {
         let src = self.src;
+        f.one_of(&["mesh", "file", "positions"])?;
         if let Some(file) = f.get("file") {
             let rel = src.string(file)?;
             let path = self.base_dir.join(rel);

@@ -191,6 +191,38 @@ impl<'a, 's> Fields<'a, 's> {
         self.get(key).map_or(Ok(default), |v| self.src.number(v))
     }
 
+    /// A number ≥ 0.
+    pub fn non_negative_or(&self, key: &str, default: f64) -> Result<f64> {
+        let Some(v) = self.get(key) else {
+            return Ok(default);
+        };
+        let n = self.src.number(v)?;
+        if n >= 0.0 {
+            Ok(n)
+        } else {
+            Err(self
+                .src
+                .error(v.span(), format!("expected {key} ≥ 0, found {n}")))
+        }
+    }
+
+    /// Exactly one of `keys` is given (or none, when `required` is false): which one.
+    pub fn one_of(&self, keys: &[&'static str]) -> Result<Option<&'static str>> {
+        let given: Vec<&'static str> = keys
+            .iter()
+            .copied()
+            .filter(|k| self.get(k).is_some())
+            .collect();
+        match given[..] {
+            [] => Ok(None),
+            [one] => Ok(Some(one)),
+            [_, second, ..] => Err(self.src.error(
+                self.get(second).map_or(self.span.clone(), |v| v.span()),
+                format!("give only one of {} in {}", keys.join(", "), self.what),
+            )),
+        }
+    }
+
     /// A number > 0.
     pub fn positive(&self, key: &str, default: Option<f64>) -> Result<f64> {
         let Some(v) = self.get(key) else {

@@ -24,6 +24,8 @@ pub enum PolyhedronError {
     TooFewFaces(usize),
     /// An edge (two vertex indices) that does not join exactly two faces.
     OpenEdge(u32, u32, usize),
+    /// Two faces run along a shared edge in the same direction: their windings disagree.
+    InconsistentWinding(u32, u32),
     /// A face (by index) that is not a valid polygon.
     Face(usize, super::polygon::PolygonError),
 }
@@ -37,6 +39,10 @@ impl std::fmt::Display for PolyhedronError {
             PolyhedronError::OpenEdge(a, b, n) => write!(
                 f,
                 "the polyhedron is not closed: edge {a}–{b} belongs to {n} face(s), not 2"
+            ),
+            PolyhedronError::InconsistentWinding(a, b) => write!(
+                f,
+                "the faces meeting at edge {a}–{b} are wound in the same direction: list every face's vertices in the same turning sense"
             ),
             PolyhedronError::Face(i, e) => write!(f, "face {i}: {e}"),
         }
@@ -120,19 +126,27 @@ impl Polyhedron {
     }
 }
 
-/// Every edge of a closed surface joins exactly two faces.
+/// Every edge of a closed surface joins exactly two faces, and consistently wound faces
+/// run along a shared edge in opposite directions.
 fn check_closed(faces: &[Vec<u32>]) -> Result<(), PolyhedronError> {
-    let mut edges: std::collections::HashMap<(u32, u32), usize> = Default::default();
+    // For each undirected edge: how many faces use it, and the net direction count.
+    let mut edges: std::collections::HashMap<(u32, u32), (usize, i32)> = Default::default();
     for face in faces {
         for i in 0..face.len() {
             let (a, b) = (face[i], face[(i + 1) % face.len()]);
-            *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+            let e = edges.entry((a.min(b), a.max(b))).or_default();
+            e.0 += 1;
+            e.1 += if a < b { 1 } else { -1 };
         }
     }
-    let mut open: Vec<_> = edges.into_iter().filter(|&(_, n)| n != 2).collect();
-    open.sort();
-    match open.first() {
-        Some(&((a, b), n)) => Err(PolyhedronError::OpenEdge(a, b, n)),
+    let mut bad: Vec<_> = edges
+        .into_iter()
+        .filter(|&(_, (n, net))| n != 2 || net != 0)
+        .collect();
+    bad.sort();
+    match bad.first() {
+        Some(&((a, b), (2, _))) => Err(PolyhedronError::InconsistentWinding(a, b)),
+        Some(&((a, b), (n, _))) => Err(PolyhedronError::OpenEdge(a, b, n)),
         None => Ok(()),
     }
 }
@@ -176,14 +190,19 @@ mod tests {
     }
 
     #[test]
-    fn open_surfaces_are_rejected() {
+    fn open_or_inconsistent_surfaces_are_rejected() {
         let v = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
-        let faces = vec![vec![0, 1, 2], vec![0, 1, 3], vec![0, 2, 3], vec![1, 2, 3]];
-        assert!(Polyhedron::new(&v, &faces).is_ok());
-        let open = vec![vec![0, 1, 2], vec![0, 1, 3], vec![0, 2, 3], vec![1, 2, 0]];
+        let tetrahedron = vec![vec![0, 2, 1], vec![0, 1, 3], vec![0, 3, 2], vec![1, 2, 3]];
+        assert!(Polyhedron::new(&v, &tetrahedron).is_ok());
+        let open = vec![vec![0, 2, 1], vec![0, 1, 3], vec![0, 3, 2], vec![1, 2, 0]];
         assert!(matches!(
             Polyhedron::new(&v, &open),
             Err(PolyhedronError::OpenEdge(..))
+        ));
+        let mixed = vec![vec![0, 1, 2], vec![0, 1, 3], vec![0, 2, 3], vec![1, 2, 3]];
+        assert!(matches!(
+            Polyhedron::new(&v, &mixed),
+            Err(PolyhedronError::InconsistentWinding(..))
         ));
     }
 }
