@@ -130,6 +130,11 @@ fn settings(view: &ViewArgs, loaded: &LoadedScene) -> Result<RenderSettings, Exi
         eprintln!("error: the image must be at least 1×1 pixels");
         return Err(ExitCode::from(2));
     }
+    // 2^28 pixels (16384 × 16384) is 3 GiB of film: beyond that, refuse rather than abort.
+    if width as u64 * height as u64 > 1 << 28 {
+        eprintln!("error: {width}×{height} is too large: at most 2^28 pixels (16384×16384)");
+        return Err(ExitCode::from(2));
+    }
     let spp = view.spp.unwrap_or(d.spp);
     if spp == 0 {
         eprintln!("error: --spp must be at least 1");

@@ -167,10 +167,16 @@ impl<'s> Reader<'s> {
         }
         if let Some(r) = f.get("resolution") {
             let [w, h] = self.src.numbers::<2>(r, "[width, height] in pixels")?;
-            if w < 1.0 || h < 1.0 || w.fract() != 0.0 || h.fract() != 0.0 {
-                return Err(self
-                    .src
-                    .error(r.span(), "expected a resolution of whole pixels ≥ 1"));
+            if w < 1.0
+                || h < 1.0
+                || w.fract() != 0.0
+                || h.fract() != 0.0
+                || w * h > (1u64 << 28) as f64
+            {
+                return Err(self.src.error(
+                    r.span(),
+                    "expected a resolution of whole pixels ≥ 1, at most 2^28 in all",
+                ));
             }
             d.width = w as u32;
             d.height = h as u32;

@@ -95,13 +95,6 @@ impl Polygon {
         self.normal
     }
 
-    /// The same polygon with its vertex order, and so its normal, reversed.
-    pub fn flipped(&self) -> Polygon {
-        let mut vertices = self.vertices.clone();
-        vertices.reverse();
-        Polygon::new(vertices).expect("reversing a valid polygon keeps it valid")
-    }
-
     pub fn bounds(&self) -> Bounds3 {
         Bounds3::from_points(self.vertices.iter().copied())
     }
