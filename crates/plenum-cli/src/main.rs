@@ -6,9 +6,9 @@
 mod trace;
 
 use clap::{Args, Parser, Subcommand};
-use plenum_core::integrator::WhittedConfig;
+use plenum_core::integrator::{WhittedConfig, MAX_DEPTH};
 use plenum_core::render::{render, RenderSettings};
-use plenum_core::sampling::PixelSampler;
+use plenum_core::sampling::{PixelSampler, MAX_SPP};
 use plenum_scene::{builtin_scene, load_scene, LoadedScene};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -136,8 +136,13 @@ fn settings(view: &ViewArgs, loaded: &LoadedScene) -> Result<RenderSettings, Exi
         return Err(ExitCode::from(2));
     }
     let spp = view.spp.unwrap_or(d.spp);
-    if spp == 0 {
-        eprintln!("error: --spp must be at least 1");
+    if spp == 0 || spp > MAX_SPP {
+        eprintln!("error: --spp must be between 1 and {MAX_SPP}");
+        return Err(ExitCode::from(2));
+    }
+    let max_depth = view.max_depth.unwrap_or(d.max_depth);
+    if max_depth > MAX_DEPTH {
+        eprintln!("error: --max-depth must be at most {MAX_DEPTH}");
         return Err(ExitCode::from(2));
     }
     let sampler = PixelSampler::grid_for(spp);
@@ -152,7 +157,7 @@ fn settings(view: &ViewArgs, loaded: &LoadedScene) -> Result<RenderSettings, Exi
         height,
         sampler,
         integrator: WhittedConfig {
-            max_depth: view.max_depth.unwrap_or(d.max_depth),
+            max_depth,
             min_weight: d.min_weight,
         },
         seed: view.seed,

@@ -5,6 +5,8 @@ use plenum_core::integrator::{RayNode, RayTree};
 use plenum_core::render::trace_pixel;
 use plenum_core::{Color, Vec3};
 use serde_json::{json, Value};
+use std::fmt::Write as _;
+use std::io::Write as _;
 use std::process::ExitCode;
 
 pub fn run(args: TracePixelArgs) -> ExitCode {
@@ -24,24 +26,29 @@ pub fn run(args: TracePixelArgs) -> ExitCode {
         return ExitCode::from(2);
     }
     let (tree, color) = trace_pixel(&loaded.scene, &settings, args.x, args.y);
+    let mut out = String::new();
     if args.json {
         let doc = json!({
             "pixel": [args.x, args.y],
             "color": rgb(color),
             "rays": tree.nodes.iter().enumerate().map(|(i, n)| node_json(i, n)).collect::<Vec<_>>(),
         });
-        println!("{}", serde_json::to_string_pretty(&doc).unwrap_or_default());
+        out = serde_json::to_string_pretty(&doc).unwrap_or_default();
+        out.push('\n');
     } else {
-        println!(
+        let _ = writeln!(
+            out,
             "pixel ({}, {}): colour {}",
             args.x,
             args.y,
             fmt_color(color)
         );
         for root in (0..tree.nodes.len()).filter(|&i| tree.nodes[i].parent.is_none()) {
-            print_node(&tree, root, 0);
+            print_node(&mut out, &tree, root, 0);
         }
     }
+    // A reader that stops early (`| head`) is not an error.
+    let _ = std::io::stdout().lock().write_all(out.as_bytes());
     ExitCode::SUCCESS
 }
 
@@ -86,7 +93,7 @@ fn fmt_vec(v: Vec3) -> String {
     format!("({:.4}, {:.4}, {:.4})", v.x, v.y, v.z)
 }
 
-fn print_node(tree: &RayTree, id: usize, indent: usize) {
+fn print_node(out: &mut String, tree: &RayTree, id: usize, indent: usize) {
     let n = &tree.nodes[id];
     let pad = "  ".repeat(indent);
     let head = format!(
@@ -97,7 +104,7 @@ fn print_node(tree: &RayTree, id: usize, indent: usize) {
         fmt_vec(n.origin),
         fmt_vec(n.direction)
     );
-    println!("{head}");
+    let _ = writeln!(out, "{head}");
     if let Some(s) = &n.shadow {
         let status = if s.blocked {
             format!("blocked by {}", s.occluders.join(", then "))
@@ -106,7 +113,8 @@ fn print_node(tree: &RayTree, id: usize, indent: usize) {
         } else {
             format!("through {}", s.occluders.join(", then "))
         };
-        println!(
+        let _ = writeln!(
+            out,
             "{pad}  to light \"{}\" at distance {:.4}: {status}; S_L = {}",
             s.light,
             n.distance.unwrap_or(f64::INFINITY),
@@ -115,21 +123,23 @@ fn print_node(tree: &RayTree, id: usize, indent: usize) {
         return;
     }
     if let (Some(object), Some(material)) = (&n.object, &n.material) {
-        println!(
+        let _ = writeln!(
+            out,
             "{pad}  hit \"{object}\" (material \"{material}\") at distance {:.4}",
             n.distance.unwrap_or(0.0)
         );
     }
     if n.total_internal_reflection {
-        println!(
+        let _ = writeln!(
+            out,
             "{pad}  total internal reflection: the refracted weight goes to the reflected ray"
         );
     }
     for stop in &n.stops {
-        println!("{pad}  stopped: {}", stop.name());
+        let _ = writeln!(out, "{pad}  stopped: {}", stop.name());
     }
-    println!("{pad}  returned {}", fmt_color(n.color));
+    let _ = writeln!(out, "{pad}  returned {}", fmt_color(n.color));
     for child in tree.children(id) {
-        print_node(tree, child, indent + 1);
+        print_node(out, tree, child, indent + 1);
     }
 }

@@ -156,7 +156,13 @@ fn bad_scenes_give_located_errors() {
             "4:13",
             "expected intensity ≥ 0",
         ),
-        ("[render]\nspp = 0\n", "2:7", "expected at least 1 sample"),
+        ("[render]\nspp = 0\n", "2:7", "expected between 1 and 65536 samples"),
+        ("[render]\nmax_depth = 1000\n", "2:13", "at most 100"),
+        (
+            "[[objects]]\ntype = \"polyhedron\"\nvertices = [[0,0,0],[1,0,0],[0,1,0],[0,0,1]]\nfaces = [[0,2,1],[0,1,3],[0,3,2],[1,2,3],[]]\n",
+            "4:42",
+            "at least 3 vertex indices",
+        ),
         (
             "[meshes.m]\npositions = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\nindices = [[0, 1, 2]]\n[[objects]]\ntype = \"mesh\"\nmesh = \"m\"\nfile = \"m.obj\"\n",
             "7:8",

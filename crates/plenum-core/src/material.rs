@@ -26,11 +26,11 @@ pub struct Material {
 }
 
 impl Default for Material {
-    /// A matte grey.
+    /// A matte grey, lit by ambient light in its own colour.
     fn default() -> Self {
         Material {
             emissive: Texture::Constant(Color::BLACK),
-            ambient: Texture::Constant(Color::BLACK),
+            ambient: Texture::Constant(Color::gray(0.8)),
             diffuse: Texture::Constant(Color::gray(0.8)),
             specular: Texture::Constant(Color::BLACK),
             shininess: 32.0,

@@ -86,7 +86,8 @@ impl Primitive {
                 // the hit, that of taking the new origin back into object space, and that of
                 // the stored inverse itself).
                 let normal = t.normal(g.n);
-                let stretch = normal.length();
+                // A degenerate normal (a shape's singular point) keeps the world's error box.
+                let stretch = normal.length().max(f64::MIN_POSITIVE);
                 let n = normal / stretch;
                 let inverse_mismatch = t.inverse_residual() * (g.p.abs().max_component() + 1.0);
                 let object_error = g.n.abs().dot(g.p_error + t.inverse_error(p))

@@ -8,9 +8,11 @@ use plenum_core::color::Color;
 use plenum_core::geometry::{
     Cone, Cuboid, Cylinder, Disk, Plane, Polygon, Polyhedron, Shape, Sphere, TriangleMesh,
 };
+use plenum_core::integrator::MAX_DEPTH;
 use plenum_core::light::{Attenuation, Light};
 use plenum_core::material::Material;
 use plenum_core::math::{Matrix4, Transform, Vec3};
+use plenum_core::sampling::MAX_SPP;
 use plenum_core::scene::{MaterialId, SceneBuilder};
 use plenum_core::texture::{ImageTexture, Texture};
 use std::collections::HashMap;
@@ -116,15 +118,21 @@ impl<'s> Reader<'s> {
             &["spp", "max_depth", "min_weight", "exposure"],
         )?;
         if let Some(spp) = f.count("spp")? {
-            if spp == 0 {
+            if spp == 0 || spp > MAX_SPP {
                 return Err(self.src.error(
                     f.required("spp")?.span(),
-                    "expected at least 1 sample per pixel",
+                    format!("expected between 1 and {MAX_SPP} samples per pixel"),
                 ));
             }
             d.spp = spp;
         }
         if let Some(depth) = f.count("max_depth")? {
+            if depth > MAX_DEPTH {
+                return Err(self.src.error(
+                    f.required("max_depth")?.span(),
+                    format!("expected a max_depth of at most {MAX_DEPTH}"),
+                ));
+            }
             d.max_depth = depth;
         }
         d.min_weight = f.non_negative_or("min_weight", d.min_weight)?;
@@ -562,13 +570,17 @@ impl<'s> Reader<'s> {
                 let top = f.vec3_or("top", Vec3::Y)?;
                 let axis = top - base;
                 let height = axis.length();
-                if height == 0.0 {
-                    let span = f.get("top").map_or(f.span.clone(), |v| v.span());
-                    return Err(src.error(span, "expected `top` to differ from `base`"));
-                }
                 let z = axis / height;
                 let (x, y) = z.orthonormal_basis();
-                let frame = Transform::frame(base, x, y, z).unwrap_or_default();
+                let frame = Transform::frame(base, x, y, z)
+                    .filter(|_| height > 0.0 && height.is_finite() && z.is_finite());
+                let Some(frame) = frame else {
+                    let span = f.get("top").map_or(f.span.clone(), |v| v.span());
+                    return Err(src.error(
+                        span,
+                        "expected `top` apart from `base` by a finite, non-zero distance",
+                    ));
+                };
                 let radius = f.positive("radius", None)?;
                 let capped = f.bool_or("capped", true)?;
                 let shape = if kind == "cylinder" {
@@ -603,6 +615,11 @@ impl<'s> Reader<'s> {
                 let fv = f.required("faces")?;
                 let mut faces = Vec::new();
                 for face in src.array(fv, "an array of faces, each an array of vertex indices")? {
+                    if src.array(face, "a face: an array of vertex indices")?.len() < 3 {
+                        return Err(
+                            src.error(face.span(), "expected a face of at least 3 vertex indices")
+                        );
+                    }
                     let mut loop_ = Vec::new();
                     for i in src.array(face, "a face: an array of vertex indices")? {
                         let index = src.index(i)?;

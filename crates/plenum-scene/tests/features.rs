@@ -197,7 +197,7 @@ material = "water"
 /// reflected and the refracted weight goes to the reflected ray; below it, it refracts out.
 #[test]
 fn total_internal_reflection_moves_the_refracted_weight_to_reflection() {
-    let slab = |look_at: &str| {
+    let slab = |look_at: &str, fresnel: bool| {
         parse_scene(
             Path::new("slab.toml"),
             &format!(
@@ -212,6 +212,7 @@ diffuse = 0
 transmissive = 0.8
 reflective = 0.1
 ior = 1.5
+fresnel = {fresnel}
 [[objects]]
 type = "box"
 name = "slab"
@@ -230,7 +231,7 @@ material = "glass"
             .count()
     };
     // 84° from the normal: beyond the critical angle.
-    let grazing = slab("[10, 1, 0]");
+    let grazing = slab("[10, 1, 0]", false);
     let (tree, _) = trace_pixel(&grazing.scene, &settings(&grazing), 1, 1);
     assert!(tree.nodes[0].total_internal_reflection);
     assert_eq!(children(&tree, RayKind::Refracted), 0);
@@ -242,9 +243,116 @@ material = "glass"
         (tree.nodes[reflected].weight.r - 0.9).abs() < 1e-12,
         "k_r + k_t"
     );
+    // With Fresnel weights, total internal reflection is reported too, and F = 1 sends
+    // the whole reflective tint (white by default) to the reflected ray.
+    let fresnel = slab("[10, 1, 0]", true);
+    let (tree, _) = trace_pixel(&fresnel.scene, &settings(&fresnel), 1, 1);
+    assert!(tree.nodes[0].total_internal_reflection);
+    let reflected = tree
+        .children(0)
+        .find(|&c| tree.nodes[c].kind == RayKind::Reflected)
+        .unwrap();
+    assert!(
+        (tree.nodes[reflected].weight.r - 0.1).abs() < 1e-12,
+        "F·k_r with F = 1"
+    );
     // 5.7° from the normal: it leaves the glass.
-    let steep = slab("[0.1, 1, 0]");
+    let steep = slab("[0.1, 1, 0]", false);
     let (tree, _) = trace_pixel(&steep.scene, &settings(&steep), 1, 1);
     assert!(!tree.nodes[0].total_internal_reflection);
     assert_eq!(children(&tree, RayKind::Refracted), 1);
+}
+
+/// A glass pane (a polygon: a sheet with no inside) lets a ray through unbent and leaves
+/// the medium alone, so a glass ball behind it still refracts from air (η 1) into glass.
+#[test]
+fn thin_sheets_do_not_change_the_medium() {
+    let loaded = parse_scene(
+        Path::new("pane.toml"),
+        r#"
+[camera]
+position = [0, 0, 10]
+look_at = [0, 0, 0]
+fov = 30
+resolution = [41, 41]
+[materials.glass]
+diffuse = 0
+transmissive = 1
+ior = 1.5
+[[objects]]
+type = "polygon"
+name = "pane"
+material = "glass"
+vertices = [[-5, -5, 5], [5, -5, 5], [5, 5, 5], [-5, 5, 5]]
+[[objects]]
+type = "sphere"
+name = "ball"
+radius = 2
+material = "glass"
+"#,
+        Path::new("."),
+    )
+    .unwrap();
+    let (tree, _) = trace_pixel(&loaded.scene, &settings(&loaded), 25, 20);
+    let chain: Vec<_> = tree
+        .nodes
+        .iter()
+        .filter(|n| matches!(n.kind, RayKind::Camera | RayKind::Refracted))
+        .collect();
+    let names: Vec<_> = chain
+        .iter()
+        .map(|n| n.object.clone().unwrap_or_default())
+        .collect();
+    assert_eq!(names, ["pane", "ball", "ball", ""]);
+    assert!(
+        (chain[1].direction - chain[0].direction).length() < 1e-12,
+        "unbent through the pane"
+    );
+    for (i, (eta_i, eta_t)) in [(1.0, 1.5), (1.5, 1.0)].into_iter().enumerate() {
+        let (incoming, outgoing) = (chain[i + 1], chain[i + 2]);
+        let n = outgoing.origin / 2.0;
+        let sin = |d: Vec3| d.cross(n).length();
+        assert!(sin(incoming.direction) > 0.05);
+        assert!((eta_i * sin(incoming.direction) - eta_t * sin(outgoing.direction)).abs() < 1e-9);
+    }
+}
+
+/// A mirror triangle whose vertex normals lean: the reflected ray follows the shading
+/// normal, so smooth meshes reflect smoothly.
+#[test]
+fn mirrors_reflect_about_the_shading_normal() {
+    let loaded = parse_scene(
+        Path::new("smooth.toml"),
+        r#"
+[camera]
+position = [0, 0, 5]
+look_at = [0, 0, 0]
+fov = 30
+resolution = [3, 3]
+[materials.mirror]
+diffuse = 0
+reflective = 1
+[[objects]]
+type = "mesh"
+material = "mirror"
+positions = [[-10, -10, 0], [10, -10, 0], [0, 10, 0]]
+normals = [[0.5, 0, 1], [0.5, 0, 1], [0.5, 0, 1]]
+indices = [[0, 1, 2]]
+"#,
+        Path::new("."),
+    )
+    .unwrap();
+    let (tree, _) = trace_pixel(&loaded.scene, &settings(&loaded), 1, 1);
+    let reflected = &tree.nodes[tree
+        .children(0)
+        .find(|&c| tree.nodes[c].kind == RayKind::Reflected)
+        .unwrap()];
+    let ns = Vec3::new(0.5, 0.0, 1.0).normalized();
+    let d = Vec3::new(0.0, 0.0, -1.0);
+    let want = d - ns * (2.0 * d.dot(ns));
+    assert!(
+        (reflected.direction - want).length() < 1e-9,
+        "{:?}",
+        reflected.direction
+    );
 }

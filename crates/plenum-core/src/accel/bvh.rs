@@ -21,7 +21,7 @@ struct Node {
     /// Leaf: index of the first item in `order`. Interior: index of the second child.
     offset: u32,
     /// Items in a leaf; 0 for interior nodes.
-    count: u16,
+    count: u32,
     /// Split axis of an interior node, for ordering the children.
     axis: u8,
 }
@@ -85,7 +85,7 @@ impl Bvh {
         match self.choose_split(items, &bounds, depth) {
             None => {
                 self.nodes[node].offset = self.order.len() as u32;
-                self.nodes[node].count = items.len() as u16;
+                self.nodes[node].count = items.len() as u32;
                 self.order.extend(items.iter().map(|it| it.index));
             }
             Some((axis, mid)) => {

@@ -88,8 +88,16 @@ impl Cone {
                 (p.x, p.y)
             };
             let p = Vec3::new(x, y, z);
-            // ∇(x² + y² − (r₀ + k·z)²) ∝ (x, y, −k·r(z)).
+            // ∇(x² + y² − (r₀ + k·z)²) ∝ (x, y, −k·r(z)). At an apex the gradient vanishes:
+            // use the axis, pointing out of the tip.
             let n = Vec3::new(x, y, -self.slope() * r).normalized();
+            let n = if n.length_squared() > 0.0 {
+                n
+            } else if self.slope() < 0.0 {
+                Vec3::Z
+            } else {
+                -Vec3::Z
+            };
             let u = if want_uv {
                 let phi = y.atan2(x);
                 (if phi < 0.0 { phi + 2.0 * PI } else { phi }) / (2.0 * PI)
@@ -135,6 +143,20 @@ mod tests {
         let g = cone.surface(&ray, &hit, true);
         let s = 0.5f64.sqrt();
         assert!((g.n - Vec3::new(-s, 0.0, s)).length() < 1e-12, "{:?}", g.n);
+    }
+
+    #[test]
+    fn apex_has_a_normal() {
+        let cone = Cone {
+            radius0: 1.0,
+            radius1: 0.0,
+            height: 1.0,
+            capped: false,
+        };
+        let ray = Ray::new(Vec3::new(0.0, 0.0, 3.0), -Vec3::Z);
+        let hit = cone.intersect(&ray, 1e9).unwrap();
+        assert!((hit.t - 2.0).abs() < 1e-12);
+        assert_eq!(cone.surface(&ray, &hit, true).n, Vec3::Z);
     }
 
     #[test]

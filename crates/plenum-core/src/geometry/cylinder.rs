@@ -25,6 +25,10 @@ impl Cylinder {
         self.shape.radius0
     }
 
+    pub fn is_capped(&self) -> bool {
+        self.shape.capped
+    }
+
     pub fn bounds(&self) -> Bounds3 {
         self.shape.bounds()
     }

@@ -15,6 +15,8 @@ pub struct TriangleMesh {
     uvs: Vec<[f64; 2]>,
     triangles: Vec<[u32; 3]>,
     bvh: Bvh,
+    /// Every edge joins exactly two triangles: the mesh bounds a solid.
+    closed: bool,
 }
 
 /// Why arrays do not make a mesh.
@@ -92,13 +94,19 @@ impl TriangleMesh {
             .map(|t| Bounds3::from_points(t.iter().map(|&i| positions[i as usize])))
             .collect();
         let bvh = Bvh::build(&bounds);
+        let closed = is_closed(&positions, &triangles);
         Ok(TriangleMesh {
             positions,
             normals,
             uvs,
             triangles,
             bvh,
+            closed,
         })
+    }
+
+    pub fn is_closed(&self) -> bool {
+        self.closed
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -164,6 +172,30 @@ impl TriangleMesh {
             uv,
         }
     }
+}
+
+/// Whether every edge is shared by exactly two triangles. Vertices are matched by position,
+/// since file formats split a corner into several vertices where normals or uvs differ.
+fn is_closed(positions: &[Vec3], triangles: &[[u32; 3]]) -> bool {
+    use std::collections::HashMap;
+    let mut canonical: HashMap<[u64; 3], u32> = HashMap::new();
+    let ids: Vec<u32> = positions
+        .iter()
+        .map(|p| {
+            let next = canonical.len() as u32;
+            *canonical
+                .entry([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
+                .or_insert(next)
+        })
+        .collect();
+    let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
+    for t in triangles {
+        let v = t.map(|i| ids[i as usize]);
+        for (a, b) in [(v[0], v[1]), (v[1], v[2]), (v[2], v[0])] {
+            *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    edges.values().all(|&n| n == 2)
 }
 
 /// a·b − c·d with one rounding error's worth of accuracy (Kahan's algorithm with FMA).
@@ -279,6 +311,15 @@ mod tests {
         let ray = Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z);
         let hit = mesh.intersect(&ray, 1e9).unwrap();
         assert_eq!(mesh.surface(&ray, &hit).n, Vec3::Z);
+        assert!(!mesh.is_closed());
+        let tetrahedron = TriangleMesh::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
+            vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+            vec![],
+            vec![],
+        )
+        .unwrap();
+        assert!(tetrahedron.is_closed());
         assert_eq!(
             TriangleMesh::new(vec![Vec3::ZERO], vec![[0, 1, 2]], vec![], vec![]).unwrap_err(),
             MeshError::IndexOutOfRange {

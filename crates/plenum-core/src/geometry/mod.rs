@@ -132,6 +132,18 @@ impl Shape {
         }
     }
 
+    /// Whether the shape bounds a solid that rays enter and leave (the plane bounds a
+    /// half-space); thin sheets such as polygons, disks and open shells do not.
+    pub fn is_closed(&self) -> bool {
+        match self {
+            Shape::Sphere(_) | Shape::Plane(_) | Shape::Cuboid(_) | Shape::Polyhedron(_) => true,
+            Shape::Cylinder(s) => s.is_capped(),
+            Shape::Cone(s) => s.capped,
+            Shape::Disk(_) | Shape::Polygon(_) => false,
+            Shape::Mesh(m) => m.is_closed(),
+        }
+    }
+
     /// A lower-case word for messages and the ray tree.
     pub fn kind_name(&self) -> &'static str {
         match self {

@@ -55,7 +55,8 @@ impl Polygon {
         let size = Bounds3::from_points(vertices.iter().copied())
             .diagonal()
             .length();
-        if area_vector.length() <= 1e-12 * size * size {
+        // Compared as area/size against size, so huge coordinates do not overflow.
+        if !(size > 0.0) || area_vector.length() / size <= 1e-12 * size {
             return Err(PolygonError::ZeroArea);
         }
         let normal = area_vector.normalized();
@@ -74,7 +75,12 @@ impl Polygon {
             _ => (0, 1),
         };
         let projected = vertices.iter().map(|v| [v[axes.0], v[axes.1]]).collect();
-        let tangent_s = (vertices[1] - vertices[0]).normalized();
+        // Texture axis along the first edge of non-zero length (a polygon has one).
+        let tangent_s = (1..vertices.len())
+            .map(|i| vertices[i] - vertices[i - 1])
+            .find(|e| e.length_squared() > 0.0)
+            .unwrap_or(Vec3::X)
+            .normalized();
         let tangent_t = normal.cross(tangent_s);
         Ok(Polygon {
             vertices,

@@ -5,7 +5,7 @@
 //! Back faces matter only for rays that start inside the solid, which only rays refracted
 //! into a transparent polyhedron do; for opaque polyhedra they are culled.
 
-use super::polygon::newell_normal;
+use super::polygon::{newell_normal, PolygonError};
 use super::{HitRecord, Polygon, Sphere, SurfaceGeometry};
 use crate::math::{Bounds3, Ray, Vec3};
 
@@ -27,7 +27,7 @@ pub enum PolyhedronError {
     /// Two faces run along a shared edge in the same direction: their windings disagree.
     InconsistentWinding(u32, u32),
     /// A face (by index) that is not a valid polygon.
-    Face(usize, super::polygon::PolygonError),
+    Face(usize, PolygonError),
 }
 
 impl std::fmt::Display for PolyhedronError {
@@ -56,6 +56,12 @@ impl Polyhedron {
     pub fn new(vertices: &[Vec3], faces: &[Vec<u32>]) -> Result<Polyhedron, PolyhedronError> {
         if faces.len() < 4 {
             return Err(PolyhedronError::TooFewFaces(faces.len()));
+        }
+        if let Some(i) = faces.iter().position(|f| f.len() < 3) {
+            return Err(PolyhedronError::Face(
+                i,
+                PolygonError::TooFewVertices(faces[i].len()),
+            ));
         }
         check_closed(faces)?;
         let loops: Vec<Vec<Vec3>> = faces

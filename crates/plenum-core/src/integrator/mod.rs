@@ -6,4 +6,4 @@ mod whitted;
 
 pub use medium::MediumStack;
 pub use ray_tree::{RayKind, RayNode, RayTree, ShadowInfo, Stop};
-pub use whitted::{RayCounts, Whitted, WhittedConfig};
+pub use whitted::{RayCounts, Whitted, WhittedConfig, MAX_DEPTH};

@@ -15,9 +15,14 @@ use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::optics::{fresnel_dielectric, reflect, refract};
 use crate::scene::{Interaction, Scene};
 
+/// The deepest recursion allowed: each bounce is a stack frame, and past a few hundred
+/// bounces the render threads' stacks would overflow.
+pub const MAX_DEPTH: u32 = 100;
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WhittedConfig {
-    /// Bounces of reflection and refraction after the camera ray (0: direct light only).
+    /// Bounces of reflection and refraction after the camera ray (0: direct light only);
+    /// at most [`MAX_DEPTH`].
     pub max_depth: u32,
     /// Rays whose weight in the pixel (largest RGB component) falls below this are not traced.
     pub min_weight: f64,
@@ -161,37 +166,55 @@ impl<'a> Whitted<'a> {
             record(&mut b, node, |n| n.color = color);
             return color;
         }
-        // The medium beyond the surface, for refraction.
-        let media_t = if kt.is_black() {
+        // Closed solids (and the half-space under a plane) are media the ray enters and
+        // leaves. Thin sheets (polygons, disks, open shells) have no inside: light crosses them
+        // unbent, as through a pane of zero thickness, and the medium stays the same.
+        let solid = self.scene.primitives[prim as usize].shape.is_closed();
+        let media_t = if kt.is_black() || !solid {
             *b.media
         } else if entering {
             b.media.entered(prim, k.ior)
         } else {
             b.media.left(prim)
         };
-        let (eta_i, eta_t) = if entering {
+        let (eta_i, eta_t) = if entering || !solid {
             (b.media.ior(), k.ior)
         } else {
             (k.ior, media_t.ior())
         };
-        if k.fresnel {
-            let f = fresnel_dielectric(v.dot(n), eta_i, eta_t);
-            kr = kr * f;
-            kt = kt * (1.0 - f);
-        }
+        // Mirror and lens directions follow the shading normal, so smooth meshes look
+        // smooth; a direction that would cross to the wrong side of the true surface falls
+        // back to the geometric normal.
+        let reflected = Some(reflect(d, ns))
+            .filter(|r| r.dot(n) > 0.0)
+            .unwrap_or_else(|| reflect(d, n));
         let refracted = if kt.is_black() {
             None
+        } else if !solid {
+            Some(d)
         } else {
-            let t = refract(d, n, eta_i / eta_t);
-            if t.is_none() {
-                kr += kt;
-                kt = Color::BLACK;
-                record(&mut b, node, |n| n.total_internal_reflection = true);
+            let eta = eta_i / eta_t;
+            match refract(d, ns, eta) {
+                Some(t) if t.dot(n) < 0.0 => Some(t),
+                Some(_) => refract(d, n, eta),
+                None => None,
             }
-            t
         };
+        let total_internal_reflection = !kt.is_black() && refracted.is_none();
+        if total_internal_reflection {
+            record(&mut b, node, |n| n.total_internal_reflection = true);
+        }
+        if k.fresnel {
+            // F = 1 under total internal reflection: everything goes to the reflected ray.
+            let f = fresnel_dielectric(v.dot(ns).max(0.0), eta_i, eta_t);
+            kr = kr * f;
+            kt = kt * (1.0 - f);
+        } else if total_internal_reflection {
+            kr += kt;
+            kt = Color::BLACK;
+        }
         let secondary = [
-            (RayKind::Reflected, kr, Some(reflect(d, n)), b.media),
+            (RayKind::Reflected, kr, Some(reflected), b.media),
             (RayKind::Refracted, kt, refracted, &media_t),
         ];
         for (kind, coefficient, direction, media) in secondary {

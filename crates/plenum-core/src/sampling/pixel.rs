@@ -3,6 +3,9 @@
 
 use super::Rng;
 
+/// The most samples per pixel a render may ask for (a 256 × 256 grid).
+pub const MAX_SPP: u32 = 1 << 16;
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PixelSampler {
     /// Regular supersampling on an n × n grid of sub-pixel centres, averaged (a box filter).
@@ -10,10 +13,10 @@ pub enum PixelSampler {
 }
 
 impl PixelSampler {
-    /// The regular grid closest to `spp` samples: n = round(√spp), at least 1.
+    /// The regular grid closest to `spp` samples: n = round(√spp), from 1 to 256.
     pub fn grid_for(spp: u32) -> PixelSampler {
         PixelSampler::Grid {
-            n: ((spp as f64).sqrt().round() as u32).max(1),
+            n: ((spp as f64).sqrt().round() as u32).clamp(1, 256),
         }
     }
 
