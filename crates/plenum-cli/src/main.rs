@@ -53,6 +53,10 @@ struct ViewArgs {
     /// Random seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// The SPD test procedure: one ray through each pixel corner ((W+1)×(H+1) rays), each
+    /// pixel the mean of its four corners; an NFF view angle then spans the corner rays.
+    #[arg(long)]
+    nff_corners: bool,
 }
 
 #[derive(Args, Default)]
@@ -122,7 +126,10 @@ fn load(path: Option<&Path>) -> Result<LoadedScene, ExitCode> {
     }
 }
 
-fn settings(view: &ViewArgs, loaded: &LoadedScene) -> Result<RenderSettings, ExitCode> {
+fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings, ExitCode> {
+    if let (true, Some(angle)) = (view.nff_corners, loaded.defaults.nff_angle) {
+        loaded.scene.camera.fov_degrees = angle;
+    }
     let d = &loaded.defaults;
     let width = view.width.unwrap_or(d.width);
     let height = view.height.unwrap_or(d.height);
@@ -161,15 +168,16 @@ fn settings(view: &ViewArgs, loaded: &LoadedScene) -> Result<RenderSettings, Exi
             min_weight: d.min_weight,
         },
         seed: view.seed,
+        corners: view.nff_corners,
     })
 }
 
 fn run_render(args: RenderArgs) -> ExitCode {
-    let loaded = match load(args.scene.as_deref()) {
+    let mut loaded = match load(args.scene.as_deref()) {
         Ok(l) => l,
         Err(code) => return code,
     };
-    let settings = match settings(&args.view, &loaded) {
+    let settings = match settings(&args.view, &mut loaded) {
         Ok(s) => s,
         Err(code) => return code,
     };

@@ -10,11 +10,11 @@ use std::io::Write as _;
 use std::process::ExitCode;
 
 pub fn run(args: TracePixelArgs) -> ExitCode {
-    let loaded = match load(Some(&args.scene)) {
+    let mut loaded = match load(Some(&args.scene)) {
         Ok(l) => l,
         Err(code) => return code,
     };
-    let settings = match settings(&args.view, &loaded) {
+    let settings = match settings(&args.view, &mut loaded) {
         Ok(s) => s,
         Err(code) => return code,
     };

@@ -230,3 +230,34 @@ fn interrupt_writes_the_partial_image() {
     assert_eq!(o.status.code(), Some(130));
     assert!(std::fs::metadata(&out).unwrap().len() > 0);
 }
+
+#[test]
+fn nff_files_render_and_report_located_errors() {
+    let dir = temp_dir("nff");
+    let good = write(
+        &dir,
+        "ok.nff",
+        "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0\nresolution 32 32\nl 2 2 5\nf 1 0 0 1 0 0 0 1\ns 0 0 0 1\n",
+    );
+    let o = plenum()
+        .arg("render")
+        .arg(&good)
+        .args(["--nff-corners", "-o"])
+        .arg(dir.join("ok.png"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("32×32") && stderr(&o).contains("1089 camera"),
+        "{}",
+        stderr(&o)
+    );
+    let bad = write(&dir, "bad.nff", "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0\nresolution 32 32\nf 1 0 0 1 0 0 0 1\ns 0 0 x 1\n");
+    let o = plenum().arg("render").arg(&bad).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("bad.nff:9:7") && stderr(&o).contains("expected a finite number"),
+        "{}",
+        stderr(&o)
+    );
+}

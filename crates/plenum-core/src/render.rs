@@ -22,6 +22,9 @@ pub struct RenderSettings {
     pub sampler: PixelSampler,
     pub integrator: WhittedConfig,
     pub seed: u64,
+    /// The SPD test procedure (Haines 1987): one ray through every pixel corner, (W+1)×(H+1)
+    /// rays in all, each pixel the average of its four corners. Replaces the sampler.
+    pub corners: bool,
 }
 
 impl Default for RenderSettings {
@@ -32,6 +35,7 @@ impl Default for RenderSettings {
             sampler: PixelSampler::Grid { n: 1 },
             integrator: WhittedConfig::default(),
             seed: 0,
+            corners: false,
         }
     }
 }
@@ -55,9 +59,11 @@ pub fn render(
     cancel: &AtomicBool,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> RenderOutput {
-    let (w, h) = (settings.width, settings.height);
-    let camera = Camera::new(&scene.camera, w, h);
+    let camera = Camera::new(&scene.camera, settings.width, settings.height);
     let whitted = Whitted::new(scene, settings.integrator);
+    // In corner mode the grid rendered is that of the corners, one ray each.
+    let extra = u32::from(settings.corners);
+    let (w, h) = (settings.width + extra, settings.height + extra);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE_SIZE))
         .flat_map(|ty| (0..w.div_ceil(TILE_SIZE)).map(move |tx| (tx * TILE_SIZE, ty * TILE_SIZE)))
         .collect();
@@ -76,7 +82,11 @@ pub fn render(
         let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
         for y in y0..y1 {
             for x in x0..x1 {
-                let c = render_pixel(&whitted, &camera, settings, x, y, &mut tile_counts, None);
+                let c = if settings.corners {
+                    whitted.camera_ray(&camera.ray(x as f64, y as f64), &mut tile_counts, None)
+                } else {
+                    render_pixel(&whitted, &camera, settings, x, y, &mut tile_counts, None)
+                };
                 pixels.push((x, y, c));
             }
         }
@@ -92,11 +102,32 @@ pub fn render(
             .add(&tile_counts);
         progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
     });
+    let film = film.into_inner().unwrap_or_else(|e| e.into_inner());
     RenderOutput {
-        film: film.into_inner().unwrap_or_else(|e| e.into_inner()),
+        film: if settings.corners {
+            average_corners(&film)
+        } else {
+            film
+        },
         counts: counts.into_inner().unwrap_or_else(|e| e.into_inner()),
         complete: complete.load(Ordering::Relaxed),
     }
+}
+
+/// Each pixel of a corner grid's image: the mean of its four corners.
+fn average_corners(corners: &Film) -> Film {
+    let (w, h) = (corners.width - 1, corners.height - 1);
+    let mut film = Film::new(w, h);
+    for y in 0..h {
+        for x in 0..w {
+            let sum = corners.get(x, y)
+                + corners.get(x + 1, y)
+                + corners.get(x, y + 1)
+                + corners.get(x + 1, y + 1);
+            film.set(x, y, sum * 0.25);
+        }
+    }
+    film
 }
 
 /// The average radiance of one pixel's samples (a box filter).
@@ -109,6 +140,14 @@ fn render_pixel(
     counts: &mut RayCounts,
     mut tree: Option<&mut RayTree>,
 ) -> Color {
+    if settings.corners {
+        let mut sum = Color::BLACK;
+        for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
+            let ray = camera.ray(x as f64 + dx, y as f64 + dy);
+            sum += whitted.camera_ray(&ray, counts, tree.as_deref_mut());
+        }
+        return sum * 0.25;
+    }
     let spp = settings.sampler.samples_per_pixel();
     let mut sum = Color::BLACK;
     for index in 0..spp {

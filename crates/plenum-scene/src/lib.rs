@@ -3,6 +3,7 @@
 
 pub mod diagnostics;
 mod native;
+mod nff;
 mod obj;
 mod reader;
 
@@ -20,6 +21,8 @@ pub struct RenderDefaults {
     pub min_weight: f64,
     /// Stops of exposure applied before clamping to 8 bits.
     pub exposure: f64,
+    /// NFF's view angle between the outermost rays, for the SPD corner-ray procedure.
+    pub nff_angle: Option<f64>,
 }
 
 impl Default for RenderDefaults {
@@ -31,6 +34,7 @@ impl Default for RenderDefaults {
             max_depth: 5,
             min_weight: 1.0 / 256.0,
             exposure: 0.0,
+            nff_angle: None,
         }
     }
 }
@@ -41,10 +45,24 @@ pub struct LoadedScene {
     pub defaults: RenderDefaults,
 }
 
-/// Reads a scene file; relative paths inside it are resolved against its folder.
+/// Reads a scene file, choosing the format by extension: `.nff` (Haines' Neutral File
+/// Format), anything else the native TOML. Relative paths inside are resolved against the
+/// file's folder.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| SceneError::file(path, format!("cannot read the scene file: {e}")))?;
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if extension == "nff" {
+        let (builder, defaults) = nff::parse(path, &text)?;
+        return Ok(LoadedScene {
+            scene: builder.build(),
+            defaults,
+        });
+    }
     let base = path.parent().unwrap_or(Path::new("."));
     parse_scene(path, &text, base)
 }

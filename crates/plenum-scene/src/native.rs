@@ -598,6 +598,7 @@ impl<'s> Reader<'s> {
                         radius1: top_radius,
                         height,
                         capped,
+                        inside_only: false,
                     })
                 };
                 return Ok((shape, frame));

@@ -20,6 +20,7 @@ fn draw(loaded: &LoadedScene, spp: u32) -> plenum_core::film::Film {
         sampler: PixelSampler::grid_for(spp),
         integrator: WhittedConfig::default(),
         seed: 1,
+        corners: false,
     };
     render(
         &loaded.scene,
@@ -271,6 +272,7 @@ fn image_does_not_depend_on_thread_count() {
         sampler: PixelSampler::grid_for(4),
         integrator: WhittedConfig::default(),
         seed: 42,
+        corners: false,
     };
     let films: Vec<Vec<[f32; 3]>> = [1, 2, 3]
         .iter()

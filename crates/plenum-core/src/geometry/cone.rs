@@ -12,6 +12,8 @@ pub struct Cone {
     pub radius1: f64,
     pub height: f64,
     pub capped: bool,
+    /// Only the inside of the side is visible (NFF's negative radii); for open cones.
+    pub inside_only: bool,
 }
 
 const SIDE: u32 = 0;
@@ -42,8 +44,13 @@ impl Cone {
         let b = 2.0 * (o.x * d.x + o.y * d.y - k * r_o * d.z);
         let c = o.x * o.x + o.y * o.y - r_o * r_o;
         let in_height = |t: f64| {
-            let z = o.z + t * d.z;
-            (0.0..=self.height).contains(&z)
+            let p = ray.at(t);
+            let facing_in = || {
+                // The outward normal ∝ (x, y, −k·r(z)) turned away from the ray: an inside hit.
+                let n = Vec3::new(p.x, p.y, -k * self.radius_at(p.z));
+                n.dot(d) > 0.0
+            };
+            (0.0..=self.height).contains(&p.z) && (!self.inside_only || facing_in())
         };
         let mut best: Option<HitRecord> = nearest_root(solve_quadratic(a, b, c), t_max, in_height)
             .map(|t| HitRecord {
@@ -136,6 +143,7 @@ mod tests {
             radius1: 0.0,
             height: 1.0,
             capped: false,
+            inside_only: false,
         };
         let ray = Ray::new(Vec3::new(-5.0, 0.0, 0.5), Vec3::X);
         let hit = cone.intersect(&ray, 1e9).unwrap();
@@ -152,6 +160,7 @@ mod tests {
             radius1: 0.0,
             height: 1.0,
             capped: false,
+            inside_only: false,
         };
         let ray = Ray::new(Vec3::new(0.0, 0.0, 3.0), -Vec3::Z);
         let hit = cone.intersect(&ray, 1e9).unwrap();
@@ -166,6 +175,7 @@ mod tests {
             radius1: 0.5,
             height: 2.0,
             capped: false,
+            inside_only: false,
         };
         let ray = Ray::new(Vec3::new(0.1, 0.0, 5.0), -Vec3::Z);
         // Open: the ray passes down the axis and leaves through the open bottom.

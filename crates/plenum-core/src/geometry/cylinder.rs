@@ -17,6 +17,7 @@ impl Cylinder {
                 radius1: radius,
                 height,
                 capped,
+                inside_only: false,
             },
         }
     }

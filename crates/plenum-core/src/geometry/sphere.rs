@@ -10,11 +10,17 @@ use std::f64::consts::PI;
 pub struct Sphere {
     pub center: Vec3,
     pub radius: f64,
+    /// Only the inside of the surface is visible (NFF's negative radius).
+    pub inside_only: bool,
 }
 
 impl Sphere {
     pub fn new(center: Vec3, radius: f64) -> Self {
-        Sphere { center, radius }
+        Sphere {
+            center,
+            radius,
+            inside_only: false,
+        }
     }
 
     pub fn bounds(&self) -> Bounds3 {
@@ -46,7 +52,14 @@ impl Sphere {
     }
 
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
-        let t = nearest_root(self.roots(ray), t_max, |_| true)?;
+        let roots = self.roots(ray);
+        // Seen from inside, the surface is always the far root.
+        let roots = if self.inside_only {
+            roots.map(|(_, t1)| (t1, t1))
+        } else {
+            roots
+        };
+        let t = nearest_root(roots, t_max, |_| true)?;
         Some(HitRecord {
             t,
             u: 0.0,
@@ -107,6 +120,14 @@ mod tests {
             .is_none());
         assert!(s.intersect(&Ray::new(Vec3::ZERO, Vec3::Z), 3.0).is_none());
         assert!(s.intersect(&Ray::new(Vec3::ZERO, -Vec3::Z), 1e9).is_none());
+    }
+
+    #[test]
+    fn inside_only_sphere_shows_its_far_side() {
+        let mut s = Sphere::new(Vec3::new(0.0, 0.0, 5.0), 1.0);
+        s.inside_only = true;
+        let hit = s.intersect(&Ray::new(Vec3::ZERO, Vec3::Z), 1e9).unwrap();
+        assert!((hit.t - 6.0).abs() < 1e-12);
     }
 
     #[test]
