@@ -119,10 +119,16 @@ fn load(path: Option<&Path>) -> Result<LoadedScene, ExitCode> {
     match path {
         None => Ok(builtin_scene()),
         Some(p) if p.as_os_str() == "-" => Ok(builtin_scene()),
-        Some(p) => load_scene(p).map_err(|e| {
-            eprintln!("{e}");
-            ExitCode::from(2)
-        }),
+        Some(p) => {
+            let loaded = load_scene(p).map_err(|e| {
+                eprintln!("{e}");
+                ExitCode::from(2)
+            })?;
+            for w in &loaded.warnings {
+                eprintln!("{w}");
+            }
+            Ok(loaded)
+        }
     }
 }
 

@@ -5,6 +5,7 @@ pub mod diagnostics;
 mod native;
 mod nff;
 mod obj;
+mod ray;
 mod reader;
 
 pub use diagnostics::SceneError;
@@ -43,10 +44,12 @@ impl Default for RenderDefaults {
 pub struct LoadedScene {
     pub scene: Scene,
     pub defaults: RenderDefaults,
+    /// Harmless problems read past (unknown fields of imported formats), one line each.
+    pub warnings: Vec<String>,
 }
 
 /// Reads a scene file, choosing the format by extension: `.nff` (Haines' Neutral File
-/// Format), anything else the native TOML. Relative paths inside are resolved against the
+/// Format), `.ray` (the course ray tracer's format), anything else the native TOML. Relative paths inside are resolved against the
 /// file's folder.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
     let text = std::fs::read_to_string(path)
@@ -56,15 +59,26 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    if extension == "nff" {
-        let (builder, defaults) = nff::parse(path, &text)?;
-        return Ok(LoadedScene {
-            scene: builder.build(),
-            defaults,
-        });
-    }
     let base = path.parent().unwrap_or(Path::new("."));
-    parse_scene(path, &text, base)
+    match extension.as_str() {
+        "nff" => {
+            let (builder, defaults) = nff::parse(path, &text)?;
+            Ok(LoadedScene {
+                scene: builder.build(),
+                defaults,
+                warnings: Vec::new(),
+            })
+        }
+        "ray" => {
+            let (builder, defaults, warnings) = ray::parse(path, &text, base)?;
+            Ok(LoadedScene {
+                scene: builder.build(),
+                defaults,
+                warnings,
+            })
+        }
+        _ => parse_scene(path, &text, base),
+    }
 }
 
 /// Parses native scene text; `path` names it in messages, `base_dir` resolves relative paths.
@@ -73,6 +87,7 @@ pub fn parse_scene(path: &Path, text: &str, base_dir: &Path) -> Result<LoadedSce
     Ok(LoadedScene {
         scene: builder.build(),
         defaults,
+        warnings: Vec::new(),
     })
 }
 
