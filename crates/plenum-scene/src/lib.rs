@@ -2,9 +2,12 @@
 //! with located diagnostics and built into a core [`plenum_core::scene::Scene`].
 
 pub mod diagnostics;
+mod model;
+mod mtl;
 mod native;
 mod nff;
 mod obj;
+mod ply;
 mod ray;
 mod reader;
 
@@ -49,16 +52,21 @@ pub struct LoadedScene {
 }
 
 /// Reads a scene file, choosing the format by extension: `.nff` (Haines' Neutral File
-/// Format), `.ray` (the course ray tracer's format), anything else the native TOML. Relative paths inside are resolved against the
+/// Format), `.ray` (the course ray tracer's format), `.obj` and `.ply` (a mesh, framed by a
+/// default camera and lights), anything else the native TOML. Relative paths inside are resolved against the
 /// file's folder.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| SceneError::file(path, format!("cannot read the scene file: {e}")))?;
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
+    if extension == "ply" {
+        // Binary: not read as text.
+        return model::load_model(path, &extension);
+    }
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| SceneError::file(path, format!("cannot read the scene file: {e}")))?;
     let base = path.parent().unwrap_or(Path::new("."));
     match extension.as_str() {
         "nff" => {
@@ -77,6 +85,7 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
                 warnings,
             })
         }
+        "obj" | "ply" => model::load_model(path, &extension),
         _ => parse_scene(path, &text, base),
     }
 }

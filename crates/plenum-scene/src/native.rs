@@ -2,7 +2,7 @@
 
 use crate::diagnostics::{did_you_mean, SceneError};
 use crate::reader::{Fields, Result, Source, Value};
-use crate::{obj, RenderDefaults};
+use crate::{obj, ply, RenderDefaults};
 use plenum_core::camera::CameraSettings;
 use plenum_core::color::Color;
 use plenum_core::geometry::{
@@ -672,26 +672,35 @@ impl<'s> Reader<'s> {
             .collect()
     }
 
-    /// A mesh from `file` (OBJ) or from inline `positions` and `indices`.
+    /// A mesh from `file` (OBJ or PLY) or from inline `positions` and `indices`.
     fn mesh_data(&self, f: &Fields<'_, 's>) -> Result<Arc<TriangleMesh>> {
         let src = self.src;
         f.one_of(&["mesh", "file", "positions"])?;
         if let Some(file) = f.get("file") {
             let rel = src.string(file)?;
             let path = self.base_dir.join(rel);
-            let text = std::fs::read_to_string(&path).map_err(|e| {
+            let extension = path
+                .extension()
+                .and_then(|e| e.to_str())
+                .unwrap_or("")
+                .to_ascii_lowercase();
+            let unreadable = |e: std::io::Error| {
                 src.error(
                     file.span(),
                     format!("cannot read mesh file `{}`: {e}", path.display()),
                 )
-            })?;
-            let is_obj = path
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
-            if !is_obj {
-                return Err(src.error(file.span(), "expected an OBJ mesh file (.obj)"));
-            }
-            return obj::parse_obj(&path, &text).map(Arc::new);
+            };
+            return match extension.as_str() {
+                "obj" => {
+                    let text = std::fs::read_to_string(&path).map_err(unreadable)?;
+                    obj::parse_obj(&path, &text).map(Arc::new)
+                }
+                "ply" => {
+                    std::fs::metadata(&path).map_err(unreadable)?;
+                    ply::load_ply(&path).map(Arc::new)
+                }
+                _ => Err(src.error(file.span(), "expected a mesh file: .obj or .ply")),
+            };
         }
         let pv = f.required("positions")?;
         let positions = self.points(pv)?;

@@ -1,6 +1,6 @@
 //! Wavefront OBJ geometry: `v`, `vt`, `vn` and `f` records (polygons fanned into triangles,
-//! negative indices counted from the end). Groups, smoothing groups and materials are read
-//! past; the native format assigns the material.
+//! negative indices counted from the end), with `usemtl` and `mtllib` recorded so a model can
+//! be split by material (see [`crate::mtl`]). Groups and smoothing groups are read past.
 
 use crate::diagnostics::SceneError;
 use plenum_core::geometry::TriangleMesh;
@@ -8,8 +8,25 @@ use plenum_core::math::Vec3;
 use std::collections::HashMap;
 use std::path::Path;
 
-/// Parses OBJ text; errors are located in `path`.
+/// An OBJ file read: one mesh per material used, and the material libraries it names.
+pub struct ObjModel {
+    /// (material name from `usemtl`, the triangles drawn with it).
+    pub groups: Vec<(Option<String>, TriangleMesh)>,
+    pub material_libraries: Vec<String>,
+}
+
+/// Parses OBJ text into one mesh of every triangle; errors are located in `path`.
 pub fn parse_obj(path: &Path, text: &str) -> Result<TriangleMesh, SceneError> {
+    let mut model = parse_obj_model(path, text, false)?;
+    Ok(model.groups.remove(0).1)
+}
+
+/// Parses OBJ text; with `by_material`, one mesh per `usemtl` material.
+pub fn parse_obj_model(path: &Path, text: &str, by_material: bool) -> Result<ObjModel, SceneError> {
+    let mut material_libraries = Vec::new();
+    let mut material_names: Vec<Option<String>> = vec![None];
+    let mut current_material = 0usize;
+    let mut triangle_material: Vec<usize> = Vec::new();
     let mut positions = Vec::new();
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
@@ -64,6 +81,17 @@ pub fn parse_obj(path: &Path, text: &str) -> Result<TriangleMesh, SceneError> {
                 let v = numbers(2, "a texture coordinate")?;
                 uvs.push([v[0], v[1]]);
             }
+            "usemtl" => {
+                let name = tokens.next().map(|(t, _)| t.to_string());
+                current_material = match material_names.iter().position(|m| *m == name) {
+                    Some(i) => i,
+                    None => {
+                        material_names.push(name);
+                        material_names.len() - 1
+                    }
+                };
+            }
+            "mtllib" => material_libraries.extend(tokens.by_ref().map(|(t, _)| t.to_string())),
             "f" => {
                 let mut corners = Vec::new();
                 for (tok, span) in tokens.by_ref() {
@@ -117,6 +145,7 @@ pub fn parse_obj(path: &Path, text: &str) -> Result<TriangleMesh, SceneError> {
                 }
                 for i in 1..corners.len() - 1 {
                     triangles.push([corners[0], corners[i], corners[i + 1]]);
+                    triangle_material.push(current_material);
                 }
             }
             _ => {}
@@ -129,8 +158,39 @@ pub fn parse_obj(path: &Path, text: &str) -> Result<TriangleMesh, SceneError> {
     if uvs.is_empty() {
         out_uvs.clear();
     }
-    TriangleMesh::new(out_positions, triangles, out_normals, out_uvs)
+    let build = |tris: Vec<[u32; 3]>| {
+        TriangleMesh::new(
+            out_positions.clone(),
+            tris,
+            out_normals.clone(),
+            out_uvs.clone(),
+        )
         .map_err(|e| SceneError::file(path, e.to_string()))
+    };
+    let groups = if by_material {
+        let mut groups = Vec::new();
+        for (m, name) in material_names.iter().enumerate() {
+            let tris: Vec<[u32; 3]> = triangles
+                .iter()
+                .zip(&triangle_material)
+                .filter(|(_, &tm)| tm == m)
+                .map(|(t, _)| *t)
+                .collect();
+            if !tris.is_empty() {
+                groups.push((name.clone(), build(tris)?));
+            }
+        }
+        if groups.is_empty() {
+            groups.push((None, build(triangles)?));
+        }
+        groups
+    } else {
+        vec![(None, build(triangles)?)]
+    };
+    Ok(ObjModel {
+        groups,
+        material_libraries,
+    })
 }
 
 /// Whitespace-separated tokens with their byte spans in the whole text.

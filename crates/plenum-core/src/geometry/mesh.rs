@@ -113,6 +113,10 @@ impl TriangleMesh {
         self.triangles.len()
     }
 
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
     pub fn bounds(&self) -> Bounds3 {
         self.bvh.bounds()
     }

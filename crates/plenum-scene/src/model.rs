@@ -1,0 +1,108 @@
+//! `plenum render model.obj` (or `.ply`): a mesh on its own, framed by a default camera and
+//! lit by default lights so it can be seen at once. OBJ files keep their MTL materials.
+
+use crate::diagnostics::SceneError;
+use crate::{mtl, obj, ply, LoadedScene, RenderDefaults};
+use plenum_core::camera::CameraSettings;
+use plenum_core::color::Color;
+use plenum_core::geometry::{Shape, TriangleMesh};
+use plenum_core::light::{Attenuation, Light};
+use plenum_core::material::Material;
+use plenum_core::math::{Transform, Vec3};
+use plenum_core::scene::SceneBuilder;
+use plenum_core::texture::Texture;
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+/// Field of view of the framing camera, in degrees.
+const FOV: f64 = 35.0;
+
+/// Loads a mesh file as a whole scene.
+pub fn load_model(path: &Path, extension: &str) -> Result<LoadedScene, SceneError> {
+    let base = path.parent().unwrap_or(Path::new("."));
+    let mut warnings = Vec::new();
+    let groups: Vec<(String, Material, TriangleMesh)> = if extension == "ply" {
+        vec![("model".into(), default_material(), ply::load_ply(path)?)]
+    } else {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| SceneError::file(path, format!("cannot read the mesh file: {e}")))?;
+        let model = obj::parse_obj_model(path, &text, true)?;
+        let mut materials: HashMap<String, Material> = HashMap::new();
+        for lib in &model.material_libraries {
+            let lib_path = base.join(lib);
+            match std::fs::read_to_string(&lib_path) {
+                Ok(t) => {
+                    let (m, w) = mtl::parse_mtl(&lib_path, &t, lib_path.parent().unwrap_or(base))?;
+                    materials.extend(m);
+                    warnings.extend(w);
+                }
+                Err(e) => warnings.push(format!(
+                    "warning: {}: cannot read material library {}: {e}; using grey",
+                    path.display(),
+                    lib_path.display()
+                )),
+            }
+        }
+        model
+            .groups
+            .into_iter()
+            .map(|(name, mesh)| {
+                let m = name.as_ref().and_then(|n| materials.get(n).cloned());
+                (
+                    name.unwrap_or_else(|| "model".into()),
+                    m.unwrap_or_else(default_material),
+                    mesh,
+                )
+            })
+            .collect()
+    };
+    let mut builder = SceneBuilder::default();
+    let mut bounds = plenum_core::math::Bounds3::default();
+    for (name, material, mesh) in groups {
+        bounds = bounds.union(&mesh.bounds());
+        let id = builder.add_material(name.clone(), material);
+        builder.add_object(name, Shape::Mesh(Arc::new(mesh)), Transform::IDENTITY, id);
+    }
+    // Frame the bounding sphere from the front-right, above; y is up, as in most OBJ files.
+    let (center, radius) = bounds.bounding_sphere();
+    let radius = radius.max(1e-9);
+    let direction = Vec3::new(0.6, 0.45, 1.0).normalized();
+    let distance = radius / (FOV.to_radians() * 0.5).sin() * 1.05;
+    let position = center + direction * distance;
+    builder.camera = CameraSettings {
+        position,
+        look_at: center,
+        up: Vec3::Y,
+        fov_degrees: FOV,
+    };
+    builder.background = Color::new(0.18, 0.2, 0.24);
+    builder.ambient = Color::gray(0.12);
+    let key = center + Vec3::new(-0.8, 1.2, 1.0).normalized() * distance * 1.5;
+    let fill = center + Vec3::new(1.2, 0.3, 0.6).normalized() * distance * 1.5;
+    for (name, at, level) in [("key", key, 0.85), ("fill", fill, 0.35)] {
+        builder.add_light(
+            name,
+            Light::Point {
+                position: at,
+                intensity: Color::gray(level),
+                attenuation: Attenuation::default(),
+            },
+        );
+    }
+    Ok(LoadedScene {
+        scene: builder.build(),
+        defaults: RenderDefaults::default(),
+        warnings,
+    })
+}
+
+fn default_material() -> Material {
+    Material {
+        diffuse: Texture::Constant(Color::new(0.75, 0.72, 0.68)),
+        ambient: Texture::Constant(Color::new(0.75, 0.72, 0.68)),
+        specular: Texture::Constant(Color::gray(0.25)),
+        shininess: 40.0,
+        ..Material::default()
+    }
+}
