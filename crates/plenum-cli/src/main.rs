@@ -33,6 +33,16 @@ enum Command {
     Render(RenderArgs),
     /// Print the ray tree of one pixel: every ray traced for it and why each branch ended.
     TracePixel(TracePixelArgs),
+    /// Write any scene Plenum reads (.toml, .nff, .ray, .obj, .ply) in the native format.
+    Convert(ConvertArgs),
+}
+
+#[derive(Args)]
+struct ConvertArgs {
+    /// The scene to read.
+    input: PathBuf,
+    /// The native scene to write (.toml).
+    output: PathBuf,
 }
 
 /// Settings shared by render and trace-pixel; each overrides the scene file's own.
@@ -111,6 +121,7 @@ fn main() -> ExitCode {
     })) {
         Command::Render(args) => run_render(args),
         Command::TracePixel(args) => trace::run(args),
+        Command::Convert(args) => convert(args),
     }
 }
 
@@ -176,6 +187,19 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
         seed: view.seed,
         corners: view.nff_corners,
     })
+}
+
+fn convert(args: ConvertArgs) -> ExitCode {
+    let loaded = match load(Some(&args.input)) {
+        Ok(l) => l,
+        Err(code) => return code,
+    };
+    let text = plenum_scene::to_toml(&loaded.scene, &loaded.defaults);
+    if let Err(e) = std::fs::write(&args.output, text) {
+        eprintln!("error: cannot write {}: {e}", args.output.display());
+        return ExitCode::from(1);
+    }
+    ExitCode::SUCCESS
 }
 
 fn run_render(args: RenderArgs) -> ExitCode {

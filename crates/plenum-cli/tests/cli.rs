@@ -261,3 +261,42 @@ fn nff_files_render_and_report_located_errors() {
         stderr(&o)
     );
 }
+
+#[test]
+fn convert_writes_a_native_scene_that_renders() {
+    let dir = temp_dir("convert");
+    let nff = write(
+        &dir,
+        "in.nff",
+        "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0\nresolution 32 32\nl 2 2 5\nf 1 0 0 1 0 0 0 1\ns 0 0 0 1\n",
+    );
+    let out = dir.join("out.toml");
+    let o = plenum()
+        .arg("convert")
+        .arg(&nff)
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        text.contains("type = \"sphere\"") && text.contains("[camera]"),
+        "{text}"
+    );
+    let o = plenum()
+        .arg("render")
+        .arg(&out)
+        .args(["-q", "-o"])
+        .arg(dir.join("x.png"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bad = write(&dir, "bad.nff", "v\nfrom 0 0 5\n");
+    let o = plenum()
+        .arg("convert")
+        .arg(&bad)
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+}

@@ -91,6 +91,12 @@ impl ImageTexture {
         })
     }
 
+    /// The mean of all texels.
+    pub fn average(&self) -> Color {
+        let sum = self.texels.iter().fold(Color::BLACK, |a, &c| a + c);
+        sum / self.texels.len() as f64
+    }
+
     fn texel(&self, x: i64, y: i64) -> Color {
         let x = x.rem_euclid(self.width as i64) as usize;
         let y = y.rem_euclid(self.height as i64) as usize;

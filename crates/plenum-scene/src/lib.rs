@@ -10,6 +10,9 @@ mod obj;
 mod ply;
 mod ray;
 mod reader;
+mod writer;
+
+pub use writer::to_toml;
 
 pub use diagnostics::SceneError;
 use plenum_core::scene::Scene;

@@ -487,12 +487,19 @@ impl<'s> Reader<'s> {
         ];
         let kind = self.kind(v, "an object", KINDS)?;
         let fields: &[&'static str] = match kind.as_str() {
-            "sphere" => &["center", "radius"],
+            "sphere" => &["center", "radius", "inside_only"],
             "plane" => &["point", "normal"],
             "disk" => &["center", "normal", "radius"],
             "box" => &["min", "max"],
             "cylinder" => &["base", "top", "radius", "capped"],
-            "cone" => &["base", "top", "radius", "top_radius", "capped"],
+            "cone" => &[
+                "base",
+                "top",
+                "radius",
+                "top_radius",
+                "capped",
+                "inside_only",
+            ],
             "polygon" => &["vertices"],
             "polyhedron" => &["vertices", "faces"],
             _ => &["mesh", "file", "positions", "indices", "normals", "uvs"],
@@ -542,10 +549,14 @@ impl<'s> Reader<'s> {
     fn shape(&mut self, kind: &str, f: &Fields<'_, 's>) -> Result<(Shape, Transform)> {
         let src = self.src;
         let shape = match kind {
-            "sphere" => Shape::Sphere(Sphere::new(
-                f.vec3_or("center", Vec3::ZERO)?,
-                f.positive("radius", None)?,
-            )),
+            "sphere" => {
+                let mut sphere = Sphere::new(
+                    f.vec3_or("center", Vec3::ZERO)?,
+                    f.positive("radius", None)?,
+                );
+                sphere.inside_only = f.bool_or("inside_only", false)?;
+                Shape::Sphere(sphere)
+            }
             "plane" => Shape::Plane(Plane::new(
                 f.vec3_or("point", Vec3::ZERO)?,
                 f.direction("normal", None)?,
@@ -598,7 +609,7 @@ impl<'s> Reader<'s> {
                         radius1: top_radius,
                         height,
                         capped,
-                        inside_only: false,
+                        inside_only: f.bool_or("inside_only", false)?,
                     })
                 };
                 return Ok((shape, frame));

@@ -979,19 +979,37 @@ impl<'s> Parser<'s> {
             "warning: {}: per-vertex materials are applied per triangle, from each triangle's first vertex",
             self.path.display()
         ));
+        // Group triangles by material: materials compared by their written form, once each.
+        let keys: Vec<String> = materials.iter().map(|m| format!("{m:?}")).collect();
+        let mut group_of: HashMap<&str, usize> = HashMap::new();
         let mut groups: Vec<(usize, Vec<[u32; 3]>)> = Vec::new();
         for t in triangles {
             let owner = t[0] as usize;
-            match groups
-                .iter_mut()
-                .find(|g| same_material(&materials[g.0], &materials[owner]))
-            {
-                Some(g) => g.1.push(t),
-                None => groups.push((owner, vec![t])),
-            }
+            let g = *group_of.entry(keys[owner].as_str()).or_insert_with(|| {
+                groups.push((owner, Vec::new()));
+                groups.len() - 1
+            });
+            groups[g].1.push(t);
         }
         for (owner, tris) in groups {
-            let mesh = TriangleMesh::new(points.clone(), tris, normals.clone(), Vec::new())
+            // Each part keeps only the vertices it uses.
+            let mut remap: HashMap<u32, u32> = HashMap::new();
+            let (mut part_points, mut part_normals) = (Vec::new(), Vec::new());
+            let tris: Vec<[u32; 3]> = tris
+                .iter()
+                .map(|t| {
+                    t.map(|i| {
+                        *remap.entry(i).or_insert_with(|| {
+                            part_points.push(points[i as usize]);
+                            if !normals.is_empty() {
+                                part_normals.push(normals[i as usize]);
+                            }
+                            (part_points.len() - 1) as u32
+                        })
+                    })
+                })
+                .collect();
+            let mesh = TriangleMesh::new(part_points, tris, part_normals, Vec::new())
                 .map_err(|e| self.error(span.clone(), e.to_string()))?;
             self.add(
                 &name,
@@ -1002,10 +1020,6 @@ impl<'s> Parser<'s> {
         }
         Ok(())
     }
-}
-
-fn same_material(a: &Material, b: &Material) -> bool {
-    format!("{a:?}") == format!("{b:?}")
 }
 
 /// Rotates `v` by the unit quaternion (r, i, j, k).

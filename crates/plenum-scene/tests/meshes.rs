@@ -50,7 +50,10 @@ fn obj_models_load_with_their_counts() {
         // The OBJ reader keeps only vertices that faces use (the bunny has 1,113 unused).
         let (used, tris) = counts(&loaded);
         assert_eq!(tris, triangles, "{file}");
-        assert!(used <= vertices && used * 10 > vertices * 9, "{file}: {used} vertices");
+        assert!(
+            used <= vertices && used * 10 > vertices * 9,
+            "{file}: {used} vertices"
+        );
         assert!(
             renders_something(&loaded),
             "{file}: the framed model is not in view"

@@ -30,6 +30,10 @@ impl Cylinder {
         self.shape.capped
     }
 
+    pub fn height(&self) -> f64 {
+        self.shape.height
+    }
+
     pub fn bounds(&self) -> Bounds3 {
         self.shape.bounds()
     }

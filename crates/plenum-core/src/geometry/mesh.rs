@@ -117,6 +117,24 @@ impl TriangleMesh {
         self.positions.len()
     }
 
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    /// Per-vertex shading normals; empty when the mesh is flat-shaded.
+    pub fn normals(&self) -> &[Vec3] {
+        &self.normals
+    }
+
+    /// Per-vertex texture coordinates; empty when the mesh has none.
+    pub fn uvs(&self) -> &[[f64; 2]] {
+        &self.uvs
+    }
+
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
     pub fn bounds(&self) -> Bounds3 {
         self.bvh.bounds()
     }

@@ -1,0 +1,285 @@
+//! Writes a scene in the native TOML format, for `plenum convert`: any format Plenum reads
+//! becomes a file a user can edit. Shapes keep their own coordinates and carry their placement
+//! as a 4×4 `matrix` step, so the written scene renders exactly as the one read. Meshes shared
+//! by several objects are written once, as `[meshes.NAME]`.
+
+use crate::RenderDefaults;
+use plenum_core::color::Color;
+use plenum_core::geometry::Shape;
+use plenum_core::light::{Attenuation, Light};
+use plenum_core::math::{Transform, Vec3};
+use plenum_core::scene::Scene;
+use plenum_core::texture::Texture;
+use std::collections::HashMap;
+use std::fmt::Write;
+
+/// The scene as native TOML. Image textures, whose files the core does not keep, are written
+/// as their average colour, with a comment saying so.
+pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
+    let mut out = String::new();
+    let w = &mut out;
+    let _ = writeln!(w, "# Written by `plenum convert`.\n");
+    let _ = writeln!(w, "background = {}\n", color(scene.background));
+    let _ = writeln!(
+        w,
+        "[render]\nspp = {}\nmax_depth = {}\nmin_weight = {:?}\nexposure = {:?}\n",
+        defaults.spp, defaults.max_depth, defaults.min_weight, defaults.exposure
+    );
+    let c = &scene.camera;
+    let _ = writeln!(
+        w,
+        "[camera]\nposition = {}\nlook_at = {}\nup = {}\nfov = {:?}\nresolution = [{}, {}]\n",
+        vec(c.position),
+        vec(c.look_at),
+        vec(c.up),
+        c.fov_degrees,
+        defaults.width,
+        defaults.height
+    );
+    let keys = unique_keys(&scene.material_names, "material");
+    for (key, m) in keys.iter().zip(&scene.materials) {
+        let _ = writeln!(w, "[materials.{}]", quote(key));
+        for (name, t) in [
+            ("emissive", &m.emissive),
+            ("ambient", &m.ambient),
+            ("diffuse", &m.diffuse),
+            ("specular", &m.specular),
+            ("reflective", &m.reflective),
+            ("transmissive", &m.transmissive),
+        ] {
+            let _ = writeln!(w, "{name} = {}", texture(t));
+        }
+        let _ = writeln!(
+            w,
+            "shininess = {:?}\nior = {:?}\nfresnel = {}\n",
+            m.shininess, m.ior, m.fresnel
+        );
+    }
+    // Meshes used more than once are written once.
+    let mut uses: HashMap<*const (), usize> = HashMap::new();
+    for p in &scene.primitives {
+        if let Shape::Mesh(m) = &p.shape {
+            *uses
+                .entry(std::sync::Arc::as_ptr(m) as *const ())
+                .or_default() += 1;
+        }
+    }
+    let mut mesh_names: HashMap<*const (), String> = HashMap::new();
+    for p in &scene.primitives {
+        if let Shape::Mesh(m) = &p.shape {
+            let ptr = std::sync::Arc::as_ptr(m) as *const ();
+            if uses[&ptr] > 1 && !mesh_names.contains_key(&ptr) {
+                let name = format!("mesh{}", mesh_names.len() + 1);
+                let _ = writeln!(w, "[meshes.{name}]\n{}", mesh_arrays(m));
+                mesh_names.insert(ptr, name);
+            }
+        }
+    }
+    if !scene.ambient.is_black() {
+        let _ = writeln!(
+            w,
+            "[[lights]]\ntype = \"ambient\"\ncolor = {}\n",
+            color(scene.ambient)
+        );
+    }
+    for (light, name) in scene.lights.iter().zip(&scene.light_names) {
+        let _ = writeln!(w, "[[lights]]\nname = {}", quote(name));
+        match light {
+            Light::Point {
+                position,
+                intensity,
+                attenuation,
+            } => {
+                let _ = writeln!(
+                    w,
+                    "type = \"point\"\nposition = {}\ncolor = {}\nattenuation = {}\n",
+                    vec(*position),
+                    color(*intensity),
+                    atten(attenuation)
+                );
+            }
+            Light::Directional {
+                direction,
+                intensity,
+            } => {
+                let _ = writeln!(
+                    w,
+                    "type = \"directional\"\ndirection = {}\ncolor = {}\n",
+                    vec(*direction),
+                    color(*intensity)
+                );
+            }
+            Light::Spot {
+                position,
+                direction,
+                cos_inner,
+                cos_outer,
+                intensity,
+                attenuation,
+            } => {
+                let _ = writeln!(
+                    w,
+                    "type = \"spot\"\nposition = {}\ndirection = {}\ninner_angle = {:?}\nouter_angle = {:?}\ncolor = {}\nattenuation = {}\n",
+                    vec(*position),
+                    vec(*direction),
+                    cos_inner.clamp(-1.0, 1.0).acos().to_degrees(),
+                    cos_outer.clamp(-1.0, 1.0).acos().to_degrees(),
+                    color(*intensity),
+                    atten(attenuation)
+                );
+            }
+        }
+    }
+    for (p, name) in scene.primitives.iter().zip(&scene.object_names) {
+        let _ = writeln!(
+            w,
+            "[[objects]]\nname = {}\nmaterial = {}",
+            quote(name),
+            quote(&keys[p.material as usize])
+        );
+        let _ = match &p.shape {
+            Shape::Sphere(s) => writeln!(w, "type = \"sphere\"\ncenter = {}\nradius = {:?}\ninside_only = {}", vec(s.center), s.radius, s.inside_only),
+            Shape::Plane(s) => writeln!(w, "type = \"plane\"\npoint = {}\nnormal = {}", vec(s.point), vec(s.normal)),
+            Shape::Disk(s) => writeln!(w, "type = \"disk\"\ncenter = {}\nnormal = {}\nradius = {:?}", vec(s.center), vec(s.normal), s.radius),
+            Shape::Cuboid(s) => writeln!(w, "type = \"box\"\nmin = {}\nmax = {}", vec(s.min), vec(s.max)),
+            Shape::Cylinder(s) => writeln!(w, "type = \"cylinder\"\nbase = [0.0, 0.0, 0.0]\ntop = [0.0, 0.0, {:?}]\nradius = {:?}\ncapped = {}", s.height(), s.radius(), s.is_capped()),
+            Shape::Cone(s) => writeln!(
+                w,
+                "type = \"cone\"\nbase = [0.0, 0.0, 0.0]\ntop = [0.0, 0.0, {:?}]\nradius = {:?}\ntop_radius = {:?}\ncapped = {}\ninside_only = {}",
+                s.height, s.radius0, s.radius1, s.capped, s.inside_only
+            ),
+            Shape::Polygon(s) => writeln!(w, "type = \"polygon\"\nvertices = {}", points(s.vertices())),
+            Shape::Polyhedron(s) => {
+                // Faces as loops into one vertex list, shared corners written once.
+                let mut vertices: Vec<Vec3> = Vec::new();
+                let mut faces = Vec::new();
+                for face in s.faces() {
+                    let ids: Vec<String> = face
+                        .vertices()
+                        .iter()
+                        .map(|v| {
+                            let i = vertices.iter().position(|u| u == v).unwrap_or_else(|| {
+                                vertices.push(*v);
+                                vertices.len() - 1
+                            });
+                            i.to_string()
+                        })
+                        .collect();
+                    faces.push(format!("[{}]", ids.join(", ")));
+                }
+                writeln!(w, "type = \"polyhedron\"\nvertices = {}\nfaces = [{}]", points(&vertices), faces.join(", "))
+            }
+            Shape::Mesh(m) => match mesh_names.get(&(std::sync::Arc::as_ptr(m) as *const ())) {
+                Some(n) => writeln!(w, "type = \"mesh\"\nmesh = {}", quote(n)),
+                None => writeln!(w, "type = \"mesh\"\n{}", mesh_arrays(m)),
+            },
+        };
+        if let Some(t) = &p.to_world {
+            let _ = writeln!(w, "transform = [{{ matrix = {} }}]", matrix(t));
+        }
+        let _ = writeln!(w);
+    }
+    out
+}
+
+fn vec(v: Vec3) -> String {
+    format!("[{:?}, {:?}, {:?}]", v.x, v.y, v.z)
+}
+
+fn color(c: Color) -> String {
+    format!("[{:?}, {:?}, {:?}]", c.r, c.g, c.b)
+}
+
+fn points(p: &[Vec3]) -> String {
+    format!(
+        "[{}]",
+        p.iter().map(|v| vec(*v)).collect::<Vec<_>>().join(", ")
+    )
+}
+
+fn atten(a: &Attenuation) -> String {
+    format!("[{:?}, {:?}, {:?}]", a.constant, a.linear, a.quadratic)
+}
+
+fn matrix(t: &Transform) -> String {
+    let rows: Vec<String> = t
+        .matrix
+        .0
+        .iter()
+        .map(|r| format!("[{:?}, {:?}, {:?}, {:?}]", r[0], r[1], r[2], r[3]))
+        .collect();
+    format!("[{}]", rows.join(", "))
+}
+
+fn texture(t: &Texture) -> String {
+    match t {
+        Texture::Constant(c) => color(*c),
+        Texture::Checker2d { even, odd, scale } => format!(
+            "{{ texture = \"checker\", even = {}, odd = {}, scale = {scale:?} }}",
+            color(*even),
+            color(*odd)
+        ),
+        Texture::Checker3d { even, odd, scale } => format!(
+            "{{ texture = \"checker3d\", even = {}, odd = {}, scale = {scale:?} }}",
+            color(*even),
+            color(*odd)
+        ),
+        Texture::Image(img) => format!(
+            "{}  # an image texture, written as its average colour",
+            color(img.average())
+        ),
+    }
+}
+
+fn mesh_arrays(m: &plenum_core::geometry::TriangleMesh) -> String {
+    let mut s = format!(
+        "positions = {}\nindices = [{}]",
+        points(m.positions()),
+        m.triangles()
+            .iter()
+            .map(|t| format!("[{}, {}, {}]", t[0], t[1], t[2]))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    if !m.normals().is_empty() {
+        s += &format!("\nnormals = {}", points(m.normals()));
+    }
+    if !m.uvs().is_empty() {
+        s += &format!(
+            "\nuvs = [{}]",
+            m.uvs()
+                .iter()
+                .map(|u| format!("[{:?}, {:?}]", u[0], u[1]))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    s
+}
+
+/// A TOML basic string.
+fn quote(s: &str) -> String {
+    format!("{s:?}")
+}
+
+/// Names made distinct: a repeated name gets " (2)", " (3)", … appended.
+fn unique_keys(names: &[String], fallback: &str) -> Vec<String> {
+    let mut seen: HashMap<String, usize> = HashMap::new();
+    names
+        .iter()
+        .map(|n| {
+            let base = if n.is_empty() {
+                fallback.to_string()
+            } else {
+                n.clone()
+            };
+            let count = seen.entry(base.clone()).or_default();
+            *count += 1;
+            if *count == 1 {
+                base
+            } else {
+                format!("{base} ({count})")
+            }
+        })
+        .collect()
+}
