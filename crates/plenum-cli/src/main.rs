@@ -203,10 +203,12 @@ fn convert(args: ConvertArgs) -> ExitCode {
 }
 
 fn run_render(args: RenderArgs) -> ExitCode {
+    let load_start = Instant::now();
     let mut loaded = match load(args.scene.as_deref()) {
         Ok(l) => l,
         Err(code) => return code,
     };
+    let load_seconds = load_start.elapsed().as_secs_f64();
     let settings = match settings(&args.view, &mut loaded) {
         Ok(s) => s,
         Err(code) => return code,
@@ -267,7 +269,8 @@ fn run_render(args: RenderArgs) -> ExitCode {
     if !args.quiet {
         let c = &output.counts;
         eprintln!(
-            "{}×{}, {} spp, {:.3} s, rays: {} camera, {} shadow, {} reflection, {} refraction; {:.2} Mrays/s → {}",
+            "loaded in {:.3} s; {}×{}, {} spp, {:.3} s, rays: {} camera, {} shadow, {} reflection, {} refraction; {:.2} Mrays/s → {}",
+            load_seconds,
             film.width,
             film.height,
             settings.sampler.samples_per_pixel(),
