@@ -95,11 +95,11 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
 
 /// Parses native scene text; `path` names it in messages, `base_dir` resolves relative paths.
 pub fn parse_scene(path: &Path, text: &str, base_dir: &Path) -> Result<LoadedScene, SceneError> {
-    let (builder, defaults) = native::parse(path, text, base_dir)?;
+    let (builder, defaults, warnings) = native::parse(path, text, base_dir)?;
     Ok(LoadedScene {
         scene: builder.build(),
         defaults,
-        warnings: Vec::new(),
+        warnings,
     })
 }
 

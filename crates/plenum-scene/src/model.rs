@@ -28,6 +28,7 @@ pub fn load_model(path: &Path, extension: &str) -> Result<LoadedScene, SceneErro
         let text = std::fs::read_to_string(path)
             .map_err(|e| SceneError::file(path, format!("cannot read the mesh file: {e}")))?;
         let model = obj::parse_obj_model(path, &text, true)?;
+        warnings.extend(model.warnings.iter().cloned());
         let mut materials: HashMap<String, Material> = HashMap::new();
         for lib in &model.material_libraries {
             let lib_path = base.join(lib);

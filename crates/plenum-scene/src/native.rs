@@ -32,7 +32,12 @@ const TOP_LEVEL: &[&str] = &[
 const COMMON: [&str; 4] = ["type", "name", "material", "transform"];
 
 /// Parses a native scene. `base_dir` resolves relative paths (meshes, textures).
-pub fn parse(path: &Path, text: &str, base_dir: &Path) -> Result<(SceneBuilder, RenderDefaults)> {
+/// Also returns warnings: statements of referenced mesh files that were read past.
+pub fn parse(
+    path: &Path,
+    text: &str,
+    base_dir: &Path,
+) -> Result<(SceneBuilder, RenderDefaults, Vec<String>)> {
     let doc = DeTable::parse(text).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
         SceneError::at(path, text, span, e.message().trim().to_string())
@@ -45,6 +50,7 @@ pub fn parse(path: &Path, text: &str, base_dir: &Path) -> Result<(SceneBuilder, 
         builder: SceneBuilder::default(),
         materials: HashMap::new(),
         meshes: HashMap::new(),
+        warnings: Vec::new(),
     };
     if let Some(v) = top.get("background") {
         reader.builder.background = reader.color(v)?;
@@ -99,7 +105,7 @@ pub fn parse(path: &Path, text: &str, base_dir: &Path) -> Result<(SceneBuilder, 
             reader.object(i, object)?;
         }
     }
-    Ok((reader.builder, defaults))
+    Ok((reader.builder, defaults, reader.warnings))
 }
 
 struct Reader<'s> {
@@ -108,6 +114,7 @@ struct Reader<'s> {
     builder: SceneBuilder,
     materials: HashMap<String, MaterialId>,
     meshes: HashMap<String, Arc<TriangleMesh>>,
+    warnings: Vec<String>,
 }
 
 impl<'s> Reader<'s> {
@@ -684,7 +691,7 @@ impl<'s> Reader<'s> {
     }
 
     /// A mesh from `file` (OBJ or PLY) or from inline `positions` and `indices`.
-    fn mesh_data(&self, f: &Fields<'_, 's>) -> Result<Arc<TriangleMesh>> {
+    fn mesh_data(&mut self, f: &Fields<'_, 's>) -> Result<Arc<TriangleMesh>> {
         let src = self.src;
         f.one_of(&["mesh", "file", "positions"])?;
         if let Some(file) = f.get("file") {
@@ -704,7 +711,9 @@ impl<'s> Reader<'s> {
             return match extension.as_str() {
                 "obj" => {
                     let text = std::fs::read_to_string(&path).map_err(unreadable)?;
-                    obj::parse_obj(&path, &text).map(Arc::new)
+                    let mut model = obj::parse_obj_model(&path, &text, false)?;
+                    self.warnings.append(&mut model.warnings);
+                    Ok(Arc::new(model.groups.remove(0).1))
                 }
                 "ply" => {
                     std::fs::metadata(&path).map_err(unreadable)?;

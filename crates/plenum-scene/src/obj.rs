@@ -13,9 +13,12 @@ pub struct ObjModel {
     /// (material name from `usemtl`, the triangles drawn with it).
     pub groups: Vec<(Option<String>, TriangleMesh)>,
     pub material_libraries: Vec<String>,
+    /// One line per kind of statement read past.
+    pub warnings: Vec<String>,
 }
 
 /// Parses OBJ text into one mesh of every triangle; errors are located in `path`.
+#[cfg(test)]
 pub fn parse_obj(path: &Path, text: &str) -> Result<TriangleMesh, SceneError> {
     let mut model = parse_obj_model(path, text, false)?;
     Ok(model.groups.remove(0).1)
@@ -27,6 +30,8 @@ pub fn parse_obj_model(path: &Path, text: &str, by_material: bool) -> Result<Obj
     let mut material_names: Vec<Option<String>> = vec![None];
     let mut current_material = 0usize;
     let mut triangle_material: Vec<usize> = Vec::new();
+    let mut skipped: Vec<(String, usize)> = Vec::new();
+    let mut line_number = 0;
     let mut positions = Vec::new();
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
@@ -38,6 +43,7 @@ pub fn parse_obj_model(path: &Path, text: &str, by_material: bool) -> Result<Obj
     let mut triangles = Vec::new();
     let mut offset = 0;
     for line in text.split_inclusive('\n') {
+        line_number += 1;
         let start = offset;
         offset += line.len();
         let content = line.split('#').next().unwrap_or("");
@@ -148,7 +154,12 @@ pub fn parse_obj_model(path: &Path, text: &str, by_material: bool) -> Result<Obj
                     triangle_material.push(current_material);
                 }
             }
-            _ => {}
+            "g" | "o" | "s" => {}
+            other => {
+                if !skipped.iter().any(|(k, _)| k == other) {
+                    skipped.push((other.to_string(), line_number));
+                }
+            }
         }
     }
     // Shading normals only when every vertex has one.
@@ -187,9 +198,19 @@ pub fn parse_obj_model(path: &Path, text: &str, by_material: bool) -> Result<Obj
     } else {
         vec![(None, build(triangles)?)]
     };
+    let warnings = skipped
+        .into_iter()
+        .map(|(k, line)| {
+            format!(
+                "warning: {}:{line}: `{k}` statements are not supported and are skipped",
+                path.display()
+            )
+        })
+        .collect();
     Ok(ObjModel {
         groups,
         material_libraries,
+        warnings,
     })
 }
 
@@ -221,6 +242,14 @@ mod tests {
         let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf -4//1 -3//1 -2//1 -1//1\n";
         let mesh = parse_obj(Path::new("q.obj"), text).unwrap();
         assert_eq!(mesh.triangle_count(), 2);
+    }
+
+    #[test]
+    fn unsupported_statements_warn_once_each() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\ncurv 0 1 1 2\ncurv 0 1 1 2\nl 1 2\nf 1 2 3\n";
+        let model = parse_obj_model(Path::new("w.obj"), text, false).unwrap();
+        assert_eq!(model.warnings.len(), 2, "{:?}", model.warnings);
+        assert!(model.warnings[0].contains("w.obj:4: `curv`"));
     }
 
     #[test]
