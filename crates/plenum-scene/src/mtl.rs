@@ -66,8 +66,10 @@ pub fn parse_mtl(
             let name = rest
                 .first()
                 .ok_or_else(|| at("expected a material name after `newmtl`".into()))?;
-            let mut m = Material::default();
-            m.specular = Texture::Constant(Color::BLACK);
+            let m = Material {
+                specular: Texture::Constant(Color::BLACK),
+                ..Material::default()
+            };
             current = Some((name.to_string(), m, 2.0));
             continue;
         }

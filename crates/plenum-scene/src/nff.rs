@@ -215,16 +215,20 @@ fn cone(base: Vec3, r0: f64, apex: Vec3, r1: f64) -> Option<(Shape, Transform)> 
     Some((shape, frame))
 }
 
+/// The patches of one surface: positions, normals and triangles of a smooth mesh.
+struct PatchGroup(MaterialId, Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>);
+
 /// `pp` patches gathered per surface into one smooth mesh each.
 #[derive(Default)]
 struct PatchMesh {
-    groups: Vec<(MaterialId, Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>)>,
+    groups: Vec<PatchGroup>,
 }
 
 impl PatchMesh {
     fn add(&mut self, m: MaterialId, corners: &[(Vec3, Vec3)]) {
         if self.groups.last().is_none_or(|g| g.0 != m) {
-            self.groups.push((m, Vec::new(), Vec::new(), Vec::new()));
+            self.groups
+                .push(PatchGroup(m, Vec::new(), Vec::new(), Vec::new()));
         }
         let g = self.groups.last_mut().expect("a group was just pushed");
         let first = g.1.len() as u32;
@@ -240,7 +244,7 @@ impl PatchMesh {
     fn finish(self, path: &Path) -> Result<Vec<(MaterialId, TriangleMesh)>, SceneError> {
         self.groups
             .into_iter()
-            .map(|(m, positions, normals, triangles)| {
+            .map(|PatchGroup(m, positions, normals, triangles)| {
                 TriangleMesh::new(positions, triangles, normals, Vec::new())
                     .map(|mesh| (m, mesh))
                     .map_err(|e| SceneError::file(path, e.to_string()))
