@@ -56,6 +56,30 @@ pub struct Coefficients {
     pub fresnel: bool,
 }
 
+impl Coefficients {
+    /// The weighted sum of several materials' coefficients (weights summing to one); Fresnel
+    /// weighting applies if any part asks for it.
+    pub fn blend(parts: &[(f64, Coefficients)]) -> Coefficients {
+        let sum = |f: fn(&Coefficients) -> Color| {
+            parts
+                .iter()
+                .fold(Color::BLACK, |acc, (w, c)| acc + f(c) * *w)
+        };
+        let mean = |f: fn(&Coefficients) -> f64| parts.iter().map(|(w, c)| w * f(c)).sum::<f64>();
+        Coefficients {
+            emissive: sum(|c| c.emissive),
+            ambient: sum(|c| c.ambient),
+            diffuse: sum(|c| c.diffuse),
+            specular: sum(|c| c.specular),
+            shininess: mean(|c| c.shininess),
+            reflective: sum(|c| c.reflective),
+            transmissive: sum(|c| c.transmissive),
+            ior: mean(|c| c.ior),
+            fresnel: parts.iter().any(|(_, c)| c.fresnel),
+        }
+    }
+}
+
 impl Material {
     pub fn evaluate(&self, at: &TextureCoords) -> Coefficients {
         Coefficients {

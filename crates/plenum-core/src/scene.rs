@@ -6,9 +6,10 @@ use crate::camera::CameraSettings;
 use crate::color::Color;
 use crate::geometry::{HitRecord, Shape};
 use crate::light::Light;
-use crate::material::Material;
+use crate::material::{Coefficients, Material};
 use crate::math::{gamma, Bounds3, Ray, Transform, Vec3};
 use crate::texture::TextureCoords;
+use std::sync::Arc;
 
 /// Index of a material in [`Scene::materials`].
 pub type MaterialId = u32;
@@ -20,6 +21,9 @@ pub struct Primitive {
     /// Object-to-world transform; `None` when the shape is already in world coordinates.
     pub to_world: Option<Box<Transform>>,
     pub material: MaterialId,
+    /// For meshes: a material per vertex, blended across each triangle by its barycentric
+    /// coordinates (the course `.ray` format's per-vertex materials). Replaces `material`.
+    pub vertex_materials: Option<Arc<Vec<MaterialId>>>,
 }
 
 /// Everything the integrator needs about a hit, in world space.
@@ -33,6 +37,8 @@ pub struct Interaction {
     pub shading_n: Vec3,
     pub texture: TextureCoords,
     pub primitive: u32,
+    /// The shape's record of the hit: which triangle, and where in it.
+    pub hit: HitRecord,
 }
 
 impl Primitive {
@@ -69,6 +75,7 @@ impl Primitive {
                         object_point: g.p,
                     },
                     primitive,
+                    hit: *hit,
                 }
             }
             Some(t) => {
@@ -103,6 +110,7 @@ impl Primitive {
                         object_point: g.p,
                     },
                     primitive,
+                    hit: *hit,
                 }
             }
         }
@@ -127,6 +135,8 @@ pub struct Scene {
     pub material_names: Vec<String>,
     pub lights: Vec<Light>,
     pub light_names: Vec<String>,
+    /// Per primitive: some light can pass through (a transmissive material or vertex material).
+    transmissive: Vec<bool>,
     /// I_a: the sum of the scene's ambient lights.
     pub ambient: Color,
     /// Radiance of rays that hit nothing.
@@ -191,6 +201,28 @@ impl Scene {
         &self.materials[self.primitives[primitive as usize].material as usize]
     }
 
+    /// Whether light can pass through the primitive anywhere.
+    pub fn is_transmissive(&self, primitive: u32) -> bool {
+        self.transmissive[primitive as usize]
+    }
+
+    /// The material's coefficients at a hit; per-vertex materials are blended by the hit's
+    /// barycentric coordinates.
+    pub fn coefficients(&self, it: &Interaction) -> Coefficients {
+        let p = &self.primitives[it.primitive as usize];
+        if let (Some(ids), Shape::Mesh(mesh)) = (&p.vertex_materials, &p.shape) {
+            let triangle = mesh.triangles()[it.hit.part as usize];
+            let (b1, b2) = (it.hit.u, it.hit.v);
+            let weights = [1.0 - b1 - b2, b1, b2];
+            let parts = [0, 1, 2].map(|i| {
+                let m = &self.materials[ids[triangle[i] as usize] as usize];
+                (weights[i], m.evaluate(&it.texture))
+            });
+            return Coefficients::blend(&parts);
+        }
+        self.material_of(it.primitive).evaluate(&it.texture)
+    }
+
     /// Bounds of all bounded primitives.
     pub fn bounds(&self) -> Bounds3 {
         self.bvh.bounds()
@@ -230,8 +262,24 @@ impl SceneBuilder {
             shape,
             to_world: (!to_world.is_identity()).then(|| Box::new(to_world)),
             material,
+            vertex_materials: None,
         });
         self.object_names.push(name.into());
+    }
+
+    /// Places a mesh whose material varies per vertex (one id per mesh vertex).
+    pub fn add_mesh_with_vertex_materials(
+        &mut self,
+        name: impl Into<String>,
+        mesh: Arc<crate::geometry::TriangleMesh>,
+        to_world: Transform,
+        vertex_materials: Vec<MaterialId>,
+    ) {
+        let first = vertex_materials.first().copied().unwrap_or(0);
+        self.add_object(name, Shape::Mesh(mesh), to_world, first);
+        if let Some(p) = self.primitives.last_mut() {
+            p.vertex_materials = Some(Arc::new(vertex_materials));
+        }
     }
 
     pub fn add_light(&mut self, name: impl Into<String>, light: Light) {
@@ -258,7 +306,18 @@ impl SceneBuilder {
                 None => unbounded.push(i as u32),
             }
         }
+        let transmissive = self
+            .primitives
+            .iter()
+            .map(|p| match &p.vertex_materials {
+                Some(ids) => ids
+                    .iter()
+                    .any(|&m| self.materials[m as usize].is_transmissive()),
+                None => self.materials[p.material as usize].is_transmissive(),
+            })
+            .collect();
         Scene {
+            transmissive,
             camera: self.camera,
             bvh: Bvh::build(&bounds),
             bounded,

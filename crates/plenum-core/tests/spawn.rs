@@ -130,6 +130,7 @@ fn spawned_rays_never_rehit_their_surface() {
                 Some(Box::new(random_transform(&mut rng)))
             };
             let prim = Primitive {
+                vertex_materials: None,
                 shape,
                 to_world,
                 material: 0,

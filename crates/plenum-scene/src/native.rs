@@ -509,7 +509,15 @@ impl<'s> Reader<'s> {
             ],
             "polygon" => &["vertices"],
             "polyhedron" => &["vertices", "faces"],
-            _ => &["mesh", "file", "positions", "indices", "normals", "uvs"],
+            _ => &[
+                "mesh",
+                "file",
+                "positions",
+                "indices",
+                "normals",
+                "uvs",
+                "vertex_materials",
+            ],
         };
         let allowed: Vec<&'static str> = COMMON.iter().chain(fields).copied().collect();
         let f = self.src.table(v, &kind, &allowed)?;
@@ -518,17 +526,41 @@ impl<'s> Reader<'s> {
             Some(t) => self.transform(t)?,
             None => Transform::IDENTITY,
         };
-        let material = self.material_ref(&f)?;
+        let material = self.material_ref(f.get("material"))?;
         let name = f
             .string("name")?
             .map_or_else(|| format!("{kind} {}", index + 1), str::to_string);
-        self.builder
-            .add_object(name, shape, placement.after(&frame), material);
+        let to_world = placement.after(&frame);
+        match (f.get("vertex_materials"), shape) {
+            (Some(list), Shape::Mesh(mesh)) => {
+                let items = self
+                    .src
+                    .array(list, "an array of material names, one per vertex")?;
+                if items.len() != mesh.vertex_count() {
+                    return Err(self.src.error(
+                        list.span(),
+                        format!(
+                            "{} vertex materials for {} vertices: give one per vertex",
+                            items.len(),
+                            mesh.vertex_count()
+                        ),
+                    ));
+                }
+                let ids = items
+                    .iter()
+                    .map(|v| self.material_ref(Some(v)))
+                    .collect::<Result<Vec<_>>>()?;
+                self.builder
+                    .add_mesh_with_vertex_materials(name, mesh, to_world, ids);
+            }
+            (_, shape) => self.builder.add_object(name, shape, to_world, material),
+        }
         Ok(())
     }
 
-    fn material_ref(&mut self, f: &Fields<'_, 's>) -> Result<MaterialId> {
-        let Some(v) = f.get("material") else {
+    /// The material a `material` value names; none given: the default matte grey.
+    fn material_ref(&mut self, value: Option<&Value<'s>>) -> Result<MaterialId> {
+        let Some(v) = value else {
             if let Some(&id) = self.materials.get("default") {
                 return Ok(id);
             }

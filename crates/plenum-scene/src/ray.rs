@@ -974,50 +974,31 @@ impl<'s> Parser<'s> {
             self.add(&name, Shape::Mesh(Arc::new(mesh)), to_world, base);
             return Ok(());
         }
-        // Per-vertex materials: each triangle takes its first vertex's material.
-        self.warnings.push(format!(
-            "warning: {}: per-vertex materials are applied per triangle, from each triangle's first vertex",
-            self.path.display()
-        ));
-        // Group triangles by material: materials compared by their written form, once each.
-        let keys: Vec<String> = materials.iter().map(|m| format!("{m:?}")).collect();
-        let mut group_of: HashMap<&str, usize> = HashMap::new();
-        let mut groups: Vec<(usize, Vec<[u32; 3]>)> = Vec::new();
-        for t in triangles {
-            let owner = t[0] as usize;
-            let g = *group_of.entry(keys[owner].as_str()).or_insert_with(|| {
-                groups.push((owner, Vec::new()));
-                groups.len() - 1
-            });
-            groups[g].1.push(t);
+        // Per-vertex materials, blended across each triangle; each distinct one is added once.
+        let mut ids: HashMap<String, u32> = HashMap::new();
+        let mut vertex_materials = Vec::with_capacity(materials.len());
+        for (i, m) in materials.iter().enumerate() {
+            let key = format!("{m:?}");
+            let id = match ids.get(&key) {
+                Some(&id) => id,
+                None => {
+                    let id = self
+                        .builder
+                        .add_material(format!("{name} vertex {i}"), m.clone());
+                    ids.insert(key, id);
+                    id
+                }
+            };
+            vertex_materials.push(id);
         }
-        for (owner, tris) in groups {
-            // Each part keeps only the vertices it uses.
-            let mut remap: HashMap<u32, u32> = HashMap::new();
-            let (mut part_points, mut part_normals) = (Vec::new(), Vec::new());
-            let tris: Vec<[u32; 3]> = tris
-                .iter()
-                .map(|t| {
-                    t.map(|i| {
-                        *remap.entry(i).or_insert_with(|| {
-                            part_points.push(points[i as usize]);
-                            if !normals.is_empty() {
-                                part_normals.push(normals[i as usize]);
-                            }
-                            (part_points.len() - 1) as u32
-                        })
-                    })
-                })
-                .collect();
-            let mesh = TriangleMesh::new(part_points, tris, part_normals, Vec::new())
-                .map_err(|e| self.error(span.clone(), e.to_string()))?;
-            self.add(
-                &name,
-                Shape::Mesh(Arc::new(mesh)),
-                to_world,
-                materials[owner].clone(),
-            );
-        }
+        let mesh = TriangleMesh::new(points, triangles, normals, Vec::new())
+            .map_err(|e| self.error(span.clone(), e.to_string()))?;
+        self.builder.add_mesh_with_vertex_materials(
+            name,
+            Arc::new(mesh),
+            to_world,
+            vertex_materials,
+        );
         Ok(())
     }
 }

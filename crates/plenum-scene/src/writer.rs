@@ -174,6 +174,10 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                 None => writeln!(w, "type = \"mesh\"\n{}", mesh_arrays(m)),
             },
         };
+        if let Some(ids) = &p.vertex_materials {
+            let names: Vec<String> = ids.iter().map(|&m| quote(&keys[m as usize])).collect();
+            let _ = writeln!(w, "vertex_materials = [{}]", names.join(", "));
+        }
         if let Some(t) = &p.to_world {
             let _ = writeln!(w, "transform = [{{ matrix = {} }}]", matrix(t));
         }

@@ -356,3 +356,39 @@ indices = [[0, 1, 2]]
         reflected.direction
     );
 }
+
+/// Per-vertex materials blend across a triangle by barycentric weight: at the centroid of a
+/// triangle whose corners glow red, green and blue, the colour is one third of each.
+#[test]
+fn vertex_materials_blend_across_triangles() {
+    let loaded = parse_scene(
+        Path::new("blend.toml"),
+        r#"
+[camera]
+position = [0, 0, 5]
+look_at = [0, 0, 0]
+fov = 30
+resolution = [3, 3]
+[materials.r]
+diffuse = 0
+emissive = [1, 0, 0]
+[materials.g]
+diffuse = 0
+emissive = [0, 1, 0]
+[materials.b]
+diffuse = 0
+emissive = [0, 0, 1]
+[[objects]]
+type = "mesh"
+positions = [[-3, -3, 0], [6, -3, 0], [-3, 6, 0]]
+indices = [[0, 1, 2]]
+vertex_materials = ["r", "g", "b"]
+"#,
+        Path::new("."),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let (_, c) = trace_pixel(&loaded.scene, &settings(&loaded), 1, 1);
+    for v in [c.r, c.g, c.b] {
+        assert!((v - 1.0 / 3.0).abs() < 1e-9, "{c:?}");
+    }
+}

@@ -120,8 +120,7 @@ impl<'a> Whitted<'a> {
             return self.scene.background;
         };
         let it = self.scene.interaction(ray, prim, &hit);
-        let material = self.scene.material_of(prim);
-        let k = material.evaluate(&it.texture);
+        let k = self.scene.coefficients(&it);
         if let (Some(t), Some(i)) = (b.tree.as_deref_mut(), node) {
             let n = &mut t.nodes[i];
             n.object = Some(self.scene.object_names[prim as usize].clone());
@@ -282,10 +281,9 @@ impl<'a> Whitted<'a> {
             if recording {
                 occluders.push((hit.t, prim));
             }
-            let material = self.scene.material_of(prim);
-            if material.is_transmissive() {
+            if self.scene.is_transmissive(prim) {
                 let occ = self.scene.interaction(&ray, prim, hit);
-                s *= material.transmissive.evaluate(&occ.texture);
+                s *= self.scene.coefficients(&occ).transmissive;
             } else {
                 s = Color::BLACK;
             }
