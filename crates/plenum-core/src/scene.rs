@@ -137,6 +137,8 @@ pub struct Scene {
     pub light_names: Vec<String>,
     /// Per primitive: some light can pass through (a transmissive material or vertex material).
     transmissive: Vec<bool>,
+    /// Per primitive: its material looks something up by texture coordinates.
+    needs_uv: Vec<bool>,
     /// I_a: the sum of the scene's ambient lights.
     pub ambient: Color,
     /// Radiance of rays that hit nothing.
@@ -193,7 +195,7 @@ impl Scene {
     }
 
     pub fn interaction(&self, ray: &Ray, primitive: u32, hit: &HitRecord) -> Interaction {
-        let want_uv = self.material_of(primitive).needs_uv();
+        let want_uv = self.needs_uv[primitive as usize];
         self.primitives[primitive as usize].interaction(ray, hit, primitive, want_uv)
     }
 
@@ -316,8 +318,17 @@ impl SceneBuilder {
                 None => self.materials[p.material as usize].is_transmissive(),
             })
             .collect();
+        let needs_uv = self
+            .primitives
+            .iter()
+            .map(|p| match &p.vertex_materials {
+                Some(ids) => ids.iter().any(|&m| self.materials[m as usize].needs_uv()),
+                None => self.materials[p.material as usize].needs_uv(),
+            })
+            .collect();
         Scene {
             transmissive,
+            needs_uv,
             camera: self.camera,
             bvh: Bvh::build(&bounds),
             bounded,

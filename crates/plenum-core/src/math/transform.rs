@@ -70,6 +70,9 @@ impl Matrix4 {
 pub struct Transform {
     pub matrix: Matrix4,
     pub inverse: Matrix4,
+    /// How far the stored inverse is from the true one (see [`Transform::inverse_residual`]),
+    /// measured once when the transform is made, not per hit.
+    residual: f64,
 }
 
 impl Default for Transform {
@@ -82,17 +85,32 @@ impl Transform {
     pub const IDENTITY: Transform = Transform {
         matrix: Matrix4::IDENTITY,
         inverse: Matrix4::IDENTITY,
+        residual: gamma(4),
     };
+
+    /// A transform from a matrix and its inverse, measuring how well they agree.
+    fn with_inverse(matrix: Matrix4, inverse: Matrix4) -> Transform {
+        let r = inverse.mul(&matrix).0;
+        let mut worst = 0.0f64;
+        for (i, row) in r.iter().enumerate().take(3) {
+            for (j, v) in row.iter().enumerate() {
+                let identity = if i == j { 1.0 } else { 0.0 };
+                worst = worst.max((v - identity).abs());
+            }
+        }
+        Transform {
+            matrix,
+            inverse,
+            residual: 2.0 * worst + gamma(4),
+        }
+    }
 
     /// `None` when the matrix is singular (a zero scale, say) or not affine.
     pub fn from_matrix(m: Matrix4) -> Option<Transform> {
         if m.0[3] != [0.0, 0.0, 0.0, 1.0] {
             return None;
         }
-        Some(Transform {
-            matrix: m,
-            inverse: m.inverse()?,
-        })
+        Some(Transform::with_inverse(m, m.inverse()?))
     }
 
     pub fn translate(d: Vec3) -> Transform {
@@ -108,10 +126,7 @@ impl Transform {
             [0.0, 0.0, 1.0, -d.z],
             [0.0, 0.0, 0.0, 1.0],
         ]);
-        Transform {
-            matrix: m,
-            inverse: inv,
-        }
+        Transform::with_inverse(m, inv)
     }
 
     /// `None` when a factor is zero.
@@ -127,10 +142,10 @@ impl Transform {
                 [0.0, 0.0, 0.0, 1.0],
             ])
         };
-        Some(Transform {
-            matrix: m(s),
-            inverse: m(Vec3::new(1.0 / s.x, 1.0 / s.y, 1.0 / s.z)),
-        })
+        Some(Transform::with_inverse(
+            m(s),
+            m(Vec3::new(1.0 / s.x, 1.0 / s.y, 1.0 / s.z)),
+        ))
     }
 
     /// A right-handed rotation by `degrees` about `axis` (Rodrigues' formula);
@@ -163,10 +178,7 @@ impl Transform {
             ],
             [0.0, 0.0, 0.0, 1.0],
         ]);
-        Some(Transform {
-            matrix: m,
-            inverse: m.transpose(),
-        })
+        Some(Transform::with_inverse(m, m.transpose()))
     }
 
     /// The rigid transform taking the object frame (origin, x, y, z axes) to the world.
@@ -181,17 +193,14 @@ impl Transform {
 
     /// `self` applied after `first`: (self ∘ first)(p) = self(first(p)).
     pub fn after(&self, first: &Transform) -> Transform {
-        Transform {
-            matrix: self.matrix.mul(&first.matrix),
-            inverse: first.inverse.mul(&self.inverse),
-        }
+        Transform::with_inverse(
+            self.matrix.mul(&first.matrix),
+            first.inverse.mul(&self.inverse),
+        )
     }
 
     pub fn inverted(&self) -> Transform {
-        Transform {
-            matrix: self.inverse,
-            inverse: self.matrix,
-        }
+        Transform::with_inverse(self.inverse, self.matrix)
     }
 
     pub fn is_identity(&self) -> bool {
@@ -233,15 +242,7 @@ impl Transform {
     /// floating point is off by about the condition number times ε, which for strong
     /// anisotropic scales dwarfs the rounding of a single product.
     pub fn inverse_residual(&self) -> f64 {
-        let r = self.inverse.mul(&self.matrix).0;
-        let mut worst = 0.0f64;
-        for (i, row) in r.iter().enumerate().take(3) {
-            for (j, v) in row.iter().enumerate() {
-                let identity = if i == j { 1.0 } else { 0.0 };
-                worst = worst.max((v - identity).abs());
-            }
-        }
-        2.0 * worst + gamma(4)
+        self.residual
     }
 
     /// Bound on the rounding error, in object space, of the world point `p` taken into object
