@@ -1,10 +1,10 @@
 //! A scene ready to render: primitives in a BVH, materials, lights, camera and background.
 //! Built once by [`SceneBuilder`]; immutable and shared by every render thread.
 
-use crate::accel::Bvh;
+use crate::accel::{Accel, AccelKind, LeafSize};
 use crate::camera::CameraSettings;
 use crate::color::Color;
-use crate::geometry::{HitRecord, Shape};
+use crate::geometry::{HitRecord, Shape, TriangleMesh};
 use crate::light::Light;
 use crate::material::{Coefficients, Material};
 use crate::math::{gamma, Bounds3, Ray, Transform, Vec3};
@@ -116,6 +116,19 @@ impl Primitive {
         }
     }
 
+    /// Some hit in (0, t_max), not necessarily the nearest (see [`Shape::intersect_any`]).
+    pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
+        match &self.to_world {
+            None => self.shape.intersect_any(ray, t_max),
+            Some(t) => {
+                let (local, dt) = t.ray_to_object(ray);
+                let mut hit = self.shape.intersect_any(&local, t_max - dt)?;
+                hit.t += dt;
+                Some(hit)
+            }
+        }
+    }
+
     pub fn world_bounds(&self) -> Option<Bounds3> {
         let b = self.shape.bounds()?;
         Some(match &self.to_world {
@@ -143,8 +156,8 @@ pub struct Scene {
     pub ambient: Color,
     /// Radiance of rays that hit nothing.
     pub background: Color,
-    bvh: Bvh,
-    /// Primitive index of each BVH item: the BVH holds the bounded primitives only.
+    accel: Accel,
+    /// Primitive index of each item of `accel`, which holds the bounded primitives only.
     bounded: Vec<u32>,
     /// Primitives without bounds (infinite planes), tested on every ray.
     unbounded: Vec<u32>,
@@ -153,12 +166,17 @@ pub struct Scene {
 impl Scene {
     /// The nearest hit in (0, t_max): the primitive's index and the hit.
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<(u32, HitRecord)> {
-        let mut best = self.bvh.intersect(ray, t_max, |i, t| {
-            self.primitives[self.bounded[i as usize] as usize].intersect(ray, t)
+        let mut best = None;
+        self.accel.traverse(ray, t_max, |items, t_max| {
+            for &i in items {
+                let prim = self.bounded[i as usize];
+                if let Some(hit) = self.primitives[prim as usize].intersect(ray, *t_max) {
+                    *t_max = hit.t;
+                    best = Some((prim, hit));
+                }
+            }
+            true
         });
-        if let Some((i, _)) = &mut best {
-            *i = self.bounded[*i as usize];
-        }
         for &i in &self.unbounded {
             let limit = best.map_or(t_max, |(_, h)| h.t);
             if let Some(hit) = self.primitives[i as usize].intersect(ray, limit) {
@@ -168,19 +186,34 @@ impl Scene {
         best
     }
 
-    /// Calls `visit(primitive, hit)` with each primitive's nearest hit in (0, t_max), in no
-    /// particular order, until `visit` returns false: an any-hit query for shadow rays.
+    /// Calls `visit(primitive, hit)` once for each primitive hit in (0, t_max), in no
+    /// particular order, until `visit` returns false: the query of shadow rays. A
+    /// transmissive primitive reports its nearest hit (where its material is looked up);
+    /// an opaque one, the first hit found.
     pub fn for_each_hit(
         &self,
         ray: &Ray,
         t_max: f64,
         mut visit: impl FnMut(u32, &HitRecord) -> bool,
     ) {
+        let hit_of = |prim: u32| {
+            let p = &self.primitives[prim as usize];
+            if self.transmissive[prim as usize] {
+                p.intersect(ray, t_max)
+            } else {
+                p.intersect_any(ray, t_max)
+            }
+        };
         let mut go_on = true;
-        self.bvh.for_each_candidate(ray, t_max, |i| {
-            let prim = self.bounded[i as usize];
-            if let Some(hit) = self.primitives[prim as usize].intersect(ray, t_max) {
-                go_on = visit(prim, &hit);
+        self.accel.traverse(ray, t_max, |items, _| {
+            for &i in items {
+                let prim = self.bounded[i as usize];
+                if let Some(hit) = hit_of(prim) {
+                    go_on = visit(prim, &hit);
+                    if !go_on {
+                        break;
+                    }
+                }
             }
             go_on
         });
@@ -188,10 +221,40 @@ impl Scene {
             if !go_on {
                 return;
             }
-            if let Some(hit) = self.primitives[i as usize].intersect(ray, t_max) {
+            if let Some(hit) = hit_of(i) {
                 go_on = visit(i, &hit);
             }
         }
+    }
+
+    /// Whether anything is hit in (0, t_max).
+    pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
+        let mut hit = false;
+        self.for_each_hit(ray, t_max, |_, _| {
+            hit = true;
+            false
+        });
+        hit
+    }
+
+    /// Which structure holds the primitives (and the triangles of every mesh).
+    pub fn accel_kind(&self) -> AccelKind {
+        self.accel.kind()
+    }
+
+    /// Bytes of the acceleration structures: the scene's and every distinct mesh's (with
+    /// the mesh's vertices and indices).
+    pub fn accel_memory_bytes(&self) -> usize {
+        let mut seen = std::collections::HashSet::new();
+        let meshes: usize = self
+            .primitives
+            .iter()
+            .filter_map(|p| match &p.shape {
+                Shape::Mesh(m) if seen.insert(Arc::as_ptr(m)) => Some(m.memory_bytes()),
+                _ => None,
+            })
+            .sum();
+        self.accel.memory_bytes() + self.bounded.len() * 4 + meshes
     }
 
     pub fn interaction(&self, ray: &Ray, primitive: u32, hit: &HitRecord) -> Interaction {
@@ -227,7 +290,7 @@ impl Scene {
 
     /// Bounds of all bounded primitives.
     pub fn bounds(&self) -> Bounds3 {
-        self.bvh.bounds()
+        self.accel.bounds()
     }
 }
 
@@ -289,7 +352,27 @@ impl SceneBuilder {
         self.light_names.push(name.into());
     }
 
-    pub fn build(mut self) -> Scene {
+    /// Builds the scene with the default acceleration structure, a BVH.
+    pub fn build(self) -> Scene {
+        self.build_with(AccelKind::Bvh)
+    }
+
+    /// Builds the scene with `kind` structures, over its primitives and inside its meshes.
+    pub fn build_with(mut self, kind: AccelKind) -> Scene {
+        if kind != AccelKind::Bvh {
+            // Meshes come with a BVH; rebuild each distinct one once, keeping instances shared.
+            let mut rebuilt: std::collections::HashMap<*const TriangleMesh, Arc<TriangleMesh>> =
+                Default::default();
+            for p in &mut self.primitives {
+                if let Shape::Mesh(m) = &mut p.shape {
+                    let key = Arc::as_ptr(m);
+                    let new = rebuilt
+                        .entry(key)
+                        .or_insert_with(|| Arc::new(m.with_accel(kind)));
+                    *m = new.clone();
+                }
+            }
+        }
         // An opaque polyhedron is never entered, so its back faces can be culled.
         for p in &mut self.primitives {
             if let Shape::Polyhedron(poly) = &mut p.shape {
@@ -330,7 +413,7 @@ impl SceneBuilder {
             transmissive,
             needs_uv,
             camera: self.camera,
-            bvh: Bvh::build(&bounds),
+            accel: Accel::build(kind, &bounds, LeafSize::SINGLE),
             bounded,
             unbounded,
             primitives: self.primitives,

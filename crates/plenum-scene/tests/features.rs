@@ -388,7 +388,8 @@ vertex_materials = ["r", "g", "b"]
     )
     .unwrap_or_else(|e| panic!("{e}"));
     let (_, c) = trace_pixel(&loaded.scene, &settings(&loaded), 1, 1);
+    // Triangles are intersected in f32, so barycentric weights carry f32 rounding.
     for v in [c.r, c.g, c.b] {
-        assert!((v - 1.0 / 3.0).abs() < 1e-9, "{c:?}");
+        assert!((v - 1.0 / 3.0).abs() < 1e-6, "{c:?}");
     }
 }

@@ -1,29 +1,44 @@
-//! A bounding-volume hierarchy built with the binned surface-area heuristic (Wald 2007), laid
-//! out depth-first so the first child follows its parent, and traversed front to back with a
-//! fixed-size stack: no allocation per ray.
+//! A four-wide bounding-volume hierarchy: a binned surface-area-heuristic build (Wald 2007)
+//! over all three axes, parallel across subtrees, whose binary splits are collapsed so each
+//! node holds four children; compact f32 nodes tested four boxes at a time with SSE; ordered
+//! front-to-back traversal with a fixed-size stack (no allocation per ray).
 //!
-//! The BVH knows only boxes; the caller's closure intersects the items in a leaf, so one
-//! structure serves triangles of a mesh and primitives of a scene alike.
+//! The BVH knows only boxes. Its leaves are runs of item indices handed to the caller's
+//! closure, so one structure serves the triangles of a mesh (tested four at once) and the
+//! primitives of a scene alike.
+//!
+//! Boxes are rounded outward to f32, and the slab test is made conservative the way pbrt-v4
+//! (§6.8.2) does it: the far distance is enlarged by the relative error of its computation,
+//! and the ray origin is rounded up or down per plane so that the f32 origin never moves a
+//! box out of the ray's way.
 
-use crate::geometry::HitRecord;
-use crate::math::{Bounds3, Ray, Vec3};
+use super::ray_f32::{round_down, round_up, BoxRay};
+use super::simd::F4;
+use crate::math::{Bounds3, Ray};
 
-const BINS: usize = 12;
-const MAX_LEAF: usize = 4;
-/// Depth of the traversal stack; builds stop splitting before this depth.
+const BINS: usize = 16;
+/// Deepest binary split; bounds the traversal stack (three entries per level at most).
 const MAX_DEPTH: usize = 64;
-/// Cost of a node visit relative to one item test.
-const TRAVERSAL_COST: f64 = 0.5;
+const STACK: usize = 3 * MAX_DEPTH + 4;
+/// Cost of visiting a node relative to testing one leaf block.
+const TRAVERSAL_COST: f32 = 1.0;
+/// Subtrees with more items than this are built in parallel.
+const PARALLEL_ITEMS: usize = 4096;
 
+/// A child reference: an interior node's index, or a leaf (top bit set) with its item run.
+const LEAF_BIT: u32 = 1 << 31;
+const COUNT_SHIFT: u32 = 27;
+const START_MASK: u32 = (1 << COUNT_SHIFT) - 1;
+/// Longest run a leaf can hold.
+pub const MAX_LEAF_ITEMS: usize = 15;
+const EMPTY: u32 = LEAF_BIT;
+
+/// Four child boxes as six planes of four lanes: min x, y, z then max x, y, z.
 #[derive(Clone, Debug)]
+#[repr(C, align(16))]
 struct Node {
-    bounds: Bounds3,
-    /// Leaf: index of the first item in `order`. Interior: index of the second child.
-    offset: u32,
-    /// Items in a leaf; 0 for interior nodes.
-    count: u32,
-    /// Split axis of an interior node, for ordering the children.
-    axis: u8,
+    planes: [[f32; 4]; 6],
+    children: [u32; 4],
 }
 
 #[derive(Clone, Debug, Default)]
@@ -31,205 +46,380 @@ pub struct Bvh {
     nodes: Vec<Node>,
     /// Item indices, grouped by leaf.
     order: Vec<u32>,
+    bounds: Bounds3,
 }
 
+#[derive(Clone, Copy)]
 struct Item {
-    bounds: Bounds3,
-    centroid: Vec3,
+    lo: [f32; 3],
+    hi: [f32; 3],
     index: u32,
 }
 
+impl Item {
+    /// Twice the centroid: all that binning needs.
+    fn center2(&self, axis: usize) -> f32 {
+        self.lo[axis] + self.hi[axis]
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Aabb {
+    lo: [f32; 3],
+    hi: [f32; 3],
+}
+
+impl Aabb {
+    const EMPTY: Aabb = Aabb {
+        lo: [f32::INFINITY; 3],
+        hi: [f32::NEG_INFINITY; 3],
+    };
+
+    fn grow(&mut self, lo: &[f32; 3], hi: &[f32; 3]) {
+        for a in 0..3 {
+            self.lo[a] = self.lo[a].min(lo[a]);
+            self.hi[a] = self.hi[a].max(hi[a]);
+        }
+    }
+
+    fn half_area(&self) -> f32 {
+        let d = [0, 1, 2].map(|a| (self.hi[a] - self.lo[a]).max(0.0));
+        d[0] * d[1] + d[1] * d[2] + d[2] * d[0]
+    }
+
+    fn of(items: &[Item]) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for it in items {
+            b.grow(&it.lo, &it.hi);
+        }
+        b
+    }
+}
+
+enum BuildNode {
+    Leaf {
+        bounds: Aabb,
+        start: u32,
+        count: u32,
+    },
+    Inner {
+        bounds: Aabb,
+        children: Vec<BuildNode>,
+    },
+}
+
+impl BuildNode {
+    fn bounds(&self) -> &Aabb {
+        match self {
+            BuildNode::Leaf { bounds, .. } | BuildNode::Inner { bounds, .. } => bounds,
+        }
+    }
+}
+
 impl Bvh {
-    /// Builds over items given by their bounds; the leaves refer to items by position.
-    pub fn build(item_bounds: &[Bounds3]) -> Bvh {
+    /// Builds over items given by their bounds, with at most `max_leaf` items per leaf, for a
+    /// caller that tests `block` items at a time; the leaves refer to items by position.
+    /// Empty boxes are left out.
+    pub fn build(item_bounds: &[Bounds3], max_leaf: usize, block: usize) -> Bvh {
+        let max_leaf = max_leaf.clamp(1, MAX_LEAF_ITEMS);
+        let block = block.clamp(1, max_leaf);
         let mut items: Vec<Item> = item_bounds
             .iter()
             .enumerate()
+            .filter(|(_, b)| !b.is_empty())
             .map(|(i, b)| Item {
-                bounds: *b,
-                centroid: b.centroid(),
+                lo: [0, 1, 2].map(|a| round_down(b.min[a])),
+                hi: [0, 1, 2].map(|a| round_up(b.max[a])),
                 index: i as u32,
             })
             .collect();
+        let bounds = item_bounds
+            .iter()
+            .fold(Bounds3::default(), |b, i| b.union(i));
+        if items.is_empty() {
+            return Bvh {
+                bounds,
+                ..Bvh::default()
+            };
+        }
+        let builder = Builder { max_leaf, block };
+        let root = builder.build(&mut items, 0, 0);
         let mut bvh = Bvh {
-            nodes: Vec::with_capacity(2 * items.len().max(1)),
-            order: Vec::with_capacity(items.len()),
+            nodes: Vec::with_capacity(items.len() / 2 + 1),
+            order: items.iter().map(|it| it.index).collect(),
+            bounds,
         };
-        if !items.is_empty() {
-            bvh.build_node(&mut items, 0);
+        match root {
+            leaf @ BuildNode::Leaf { .. } => {
+                bvh.flatten_children(&[leaf]);
+            }
+            BuildNode::Inner { children, .. } => {
+                bvh.flatten_children(&children);
+            }
         }
         bvh
     }
 
     pub fn bounds(&self) -> Bounds3 {
-        self.nodes
-            .first()
-            .map_or_else(Bounds3::default, |n| n.bounds)
+        self.bounds
     }
 
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
 
-    fn build_node(&mut self, items: &mut [Item], depth: usize) -> usize {
-        let bounds = items
-            .iter()
-            .fold(Bounds3::default(), |b, it| b.union(&it.bounds));
-        let node = self.nodes.len();
-        self.nodes.push(Node {
-            bounds,
-            offset: 0,
-            count: 0,
-            axis: 0,
-        });
-        match self.choose_split(items, &bounds, depth) {
-            None => {
-                self.nodes[node].offset = self.order.len() as u32;
-                self.nodes[node].count = items.len() as u32;
-                self.order.extend(items.iter().map(|it| it.index));
-            }
-            Some((axis, mid)) => {
-                let (left, right) = items.split_at_mut(mid);
-                self.build_node(left, depth + 1);
-                let second = self.build_node(right, depth + 1);
-                self.nodes[node].offset = second as u32;
-                self.nodes[node].axis = axis as u8;
-            }
-        }
-        node
+    pub fn memory_bytes(&self) -> usize {
+        self.nodes.len() * std::mem::size_of::<Node>() + self.order.len() * 4
     }
 
-    /// Partitions `items` by the cheapest SAH split; `None` makes a leaf.
-    fn choose_split(
-        &self,
-        items: &mut [Item],
-        bounds: &Bounds3,
-        depth: usize,
-    ) -> Option<(usize, usize)> {
-        let n = items.len();
-        if n <= 1 || depth + 1 >= MAX_DEPTH {
-            return None;
-        }
-        let centroids = items
-            .iter()
-            .fold(Bounds3::default(), |b, it| b.union_point(it.centroid));
-        let axis = centroids.diagonal().max_abs_axis();
-        let (lo, hi) = (centroids.min[axis], centroids.max[axis]);
-        if hi <= lo {
-            // All centroids coincide: no split separates them.
-            return (n > MAX_LEAF).then_some((axis, n / 2));
-        }
-        let bin_of = |c: Vec3| (((c[axis] - lo) / (hi - lo) * BINS as f64) as usize).min(BINS - 1);
-        let mut bin_bounds = [Bounds3::default(); BINS];
-        let mut bin_counts = [0usize; BINS];
-        for it in items.iter() {
-            let b = bin_of(it.centroid);
-            bin_bounds[b] = bin_bounds[b].union(&it.bounds);
-            bin_counts[b] += 1;
-        }
-        // Sweep from the right to get the area and count of every suffix of bins.
-        let mut right_area = [0.0; BINS];
-        let mut right_count = [0usize; BINS];
-        let (mut acc, mut count) = (Bounds3::default(), 0);
-        for i in (1..BINS).rev() {
-            acc = acc.union(&bin_bounds[i]);
-            count += bin_counts[i];
-            right_area[i] = acc.surface_area();
-            right_count[i] = count;
-        }
-        let (mut best, mut best_cost) = (0, f64::INFINITY);
-        let (mut acc, mut count) = (Bounds3::default(), 0);
-        for i in 0..BINS - 1 {
-            acc = acc.union(&bin_bounds[i]);
-            count += bin_counts[i];
-            let cost =
-                count as f64 * acc.surface_area() + right_count[i + 1] as f64 * right_area[i + 1];
-            if cost < best_cost {
-                best_cost = cost;
-                best = i;
+    /// Appends a node holding `children` (at most four), then their subtrees depth-first.
+    fn flatten_children(&mut self, children: &[BuildNode]) -> u32 {
+        let index = self.nodes.len();
+        let mut node = Node {
+            planes: [
+                [f32::INFINITY; 4],
+                [f32::INFINITY; 4],
+                [f32::INFINITY; 4],
+                [f32::NEG_INFINITY; 4],
+                [f32::NEG_INFINITY; 4],
+                [f32::NEG_INFINITY; 4],
+            ],
+            children: [EMPTY; 4],
+        };
+        for (slot, child) in children.iter().enumerate() {
+            let b = child.bounds();
+            for a in 0..3 {
+                node.planes[a][slot] = b.lo[a];
+                node.planes[3 + a][slot] = b.hi[a];
             }
         }
-        let split_cost = TRAVERSAL_COST + best_cost / bounds.surface_area().max(f64::MIN_POSITIVE);
-        if n <= MAX_LEAF && split_cost >= n as f64 {
-            return None;
+        self.nodes.push(node);
+        for (slot, child) in children.iter().enumerate() {
+            let reference = match child {
+                BuildNode::Leaf { start, count, .. } => LEAF_BIT | (count << COUNT_SHIFT) | start,
+                BuildNode::Inner { children, .. } => self.flatten_children(children),
+            };
+            self.nodes[index].children[slot] = reference;
         }
-        let mid = partition(items, |it| bin_of(it.centroid) <= best);
-        if mid == 0 || mid == n {
-            return Some((axis, n / 2));
-        }
-        Some((axis, mid))
+        index as u32
     }
 
-    /// The nearest hit in (0, t_max): `hit_item(index, t_max)` tests one item against the ray
-    /// and is called with a shrinking `t_max`. Returns the item index and its hit.
-    pub fn intersect(
-        &self,
-        ray: &Ray,
-        t_max: f64,
-        mut hit_item: impl FnMut(u32, f64) -> Option<HitRecord>,
-    ) -> Option<(u32, HitRecord)> {
-        let mut best = None;
-        self.traverse(ray, t_max, |item, t_max| {
-            if let Some(hit) = hit_item(item, *t_max) {
-                *t_max = hit.t;
-                best = Some((item, hit));
-            }
-            true
-        });
-        best
-    }
-
-    /// Calls `visit(item)` for every item in a leaf whose box the ray crosses in (0, t_max),
-    /// until `visit` returns false. For queries that want every hit, not the nearest one.
-    pub fn for_each_candidate(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(u32) -> bool) {
-        self.traverse(ray, t_max, |item, _| visit(item));
-    }
-
-    /// Front-to-back traversal with a fixed-size stack. `visit(item, t_max)` may shrink
-    /// `t_max` to prune farther nodes, and returns false to stop.
-    fn traverse(&self, ray: &Ray, mut t_max: f64, mut visit: impl FnMut(u32, &mut f64) -> bool) {
+    /// Front-to-back traversal. `visit(items, t_max)` is called with the items of each leaf
+    /// whose box the ray crosses in (0, t_max); it may shrink `t_max` to prune farther boxes,
+    /// and returns false to stop.
+    #[inline]
+    pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
         if self.nodes.is_empty() {
             return;
         }
-        let inv_dir = Vec3::new(
-            1.0 / ray.direction.x,
-            1.0 / ray.direction.y,
-            1.0 / ray.direction.z,
-        );
-        let negative = [inv_dir.x < 0.0, inv_dir.y < 0.0, inv_dir.z < 0.0];
-        let mut stack = [0u32; MAX_DEPTH];
-        let mut top = 0;
-        let mut current = 0usize;
+        let r = BoxRay::new(ray);
+        let mut t_max = t_max;
+        let mut far = F4::splat(round_up(t_max));
+        let mut stack = [(0u32, 0f32); STACK];
+        let mut top = 0usize;
+        let mut current = 0u32;
         loop {
-            let node = &self.nodes[current];
-            if node.bounds.intersect(ray, inv_dir, t_max).is_some() {
-                if node.count > 0 {
-                    let start = node.offset as usize;
-                    for &item in &self.order[start..start + node.count as usize] {
-                        if !visit(item, &mut t_max) {
-                            return;
-                        }
+            if current & LEAF_BIT != 0 {
+                let start = (current & START_MASK) as usize;
+                let count = ((current & !LEAF_BIT) >> COUNT_SHIFT) as usize;
+                if !visit(&self.order[start..start + count], &mut t_max) {
+                    return;
+                }
+                far = F4::splat(round_up(t_max));
+            } else {
+                let node = &self.nodes[current as usize];
+                let (near, mut hits) = r.test4(&node.planes, far);
+                if hits != 0 {
+                    let near = near.to_array();
+                    // The nearest hit child is visited next; the others wait on the stack,
+                    // nearest on top.
+                    let first = hits.trailing_zeros() as usize;
+                    hits &= hits - 1;
+                    if hits == 0 {
+                        current = node.children[first];
+                        continue;
                     }
-                } else {
-                    // Visit the child on the ray's near side first.
-                    let (first, second) = if negative[node.axis as usize] {
-                        (node.offset as usize, current + 1)
-                    } else {
-                        (current + 1, node.offset as usize)
-                    };
-                    stack[top] = second as u32;
-                    top += 1;
-                    current = first;
+                    let mut best = (node.children[first], near[first]);
+                    let base = top;
+                    while hits != 0 {
+                        let i = hits.trailing_zeros() as usize;
+                        hits &= hits - 1;
+                        let mut entry = (node.children[i], near[i]);
+                        if entry.1 < best.1 {
+                            std::mem::swap(&mut entry, &mut best);
+                        }
+                        // Insert keeping [base, top) sorted by decreasing distance.
+                        let mut j = top;
+                        while j > base && stack[j - 1].1 < entry.1 {
+                            stack[j] = stack[j - 1];
+                            j -= 1;
+                        }
+                        stack[j] = entry;
+                        top += 1;
+                    }
+                    current = best.0;
                     continue;
                 }
             }
-            if top == 0 {
-                return;
+            // Pop the nearest waiting child still in reach.
+            let limit = far.to_array()[0];
+            loop {
+                if top == 0 {
+                    return;
+                }
+                top -= 1;
+                let (next, near) = stack[top];
+                if near <= limit {
+                    current = next;
+                    break;
+                }
             }
-            top -= 1;
-            current = stack[top] as usize;
         }
     }
+}
+
+struct Builder {
+    max_leaf: usize,
+    /// Items the caller tests at once: a leaf of `block` items costs one test.
+    block: usize,
+}
+
+impl Builder {
+    /// Builds the subtree over `items`, which start at `offset` in the final item order.
+    fn build(&self, items: &mut [Item], offset: usize, depth: usize) -> BuildNode {
+        let bounds = Aabb::of(items);
+        let Some(mid) = self.split(items, &bounds, depth) else {
+            return BuildNode::Leaf {
+                bounds,
+                start: offset as u32,
+                count: items.len() as u32,
+            };
+        };
+        // Split the larger parts again until there are four children (or nothing splits).
+        let mut parts: Vec<(usize, usize, Aabb, bool)> = vec![
+            (0, mid, Aabb::of(&items[..mid]), true),
+            (mid, items.len(), Aabb::of(&items[mid..]), true),
+        ];
+        while parts.len() < 4 {
+            let Some(k) = (0..parts.len())
+                .filter(|&k| parts[k].3 && parts[k].1 - parts[k].0 > 1)
+                .max_by(|&a, &b| parts[a].2.half_area().total_cmp(&parts[b].2.half_area()))
+            else {
+                break;
+            };
+            let (s, e, b, _) = parts[k];
+            match self.split(&mut items[s..e], &b, depth + 1) {
+                Some(m) => {
+                    parts[k] = (s, s + m, Aabb::of(&items[s..s + m]), true);
+                    parts.push((s + m, e, Aabb::of(&items[s + m..e]), true));
+                }
+                None => parts[k].3 = false,
+            }
+        }
+        parts.sort_by_key(|p| p.0);
+        // Hand each part its own slice of the items.
+        let mut slices = Vec::with_capacity(parts.len());
+        let mut rest = &mut items[..];
+        let mut consumed = 0;
+        for &(s, e, _, _) in &parts {
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(e - consumed);
+            debug_assert_eq!(s, consumed);
+            slices.push((head, offset + s));
+            rest = tail;
+            consumed = e;
+        }
+        let children: Vec<BuildNode> = if items_len(&slices) > PARALLEL_ITEMS {
+            use rayon::prelude::*;
+            slices
+                .into_par_iter()
+                .map(|(slice, off)| self.build(slice, off, depth + 2))
+                .collect()
+        } else {
+            slices
+                .into_iter()
+                .map(|(slice, off)| self.build(slice, off, depth + 2))
+                .collect()
+        };
+        BuildNode::Inner { bounds, children }
+    }
+
+    /// Partitions `items` by the cheapest binned SAH split over the three axes and returns the
+    /// size of the first part; `None` makes a leaf.
+    fn split(&self, items: &mut [Item], bounds: &Aabb, depth: usize) -> Option<usize> {
+        let n = items.len();
+        let must_split = n > self.max_leaf;
+        if n <= 1 || (depth + 2 >= MAX_DEPTH && !must_split) {
+            return None;
+        }
+        let mut centers = Aabb::EMPTY;
+        for it in items.iter() {
+            let c = [it.center2(0), it.center2(1), it.center2(2)];
+            centers.grow(&c, &c);
+        }
+        let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, last bin on the left)
+        for axis in 0..3 {
+            let (lo, hi) = (centers.lo[axis], centers.hi[axis]);
+            if hi <= lo {
+                continue;
+            }
+            let scale = BINS as f32 / (hi - lo);
+            let mut bins = [Aabb::EMPTY; BINS];
+            let mut counts = [0usize; BINS];
+            for it in items.iter() {
+                let b = (((it.center2(axis) - lo) * scale) as usize).min(BINS - 1);
+                bins[b].grow(&it.lo, &it.hi);
+                counts[b] += 1;
+            }
+            let mut right_cost = [0.0f32; BINS];
+            let (mut acc, mut count) = (Aabb::EMPTY, 0);
+            for i in (1..BINS).rev() {
+                acc.grow(&bins[i].lo, &bins[i].hi);
+                count += counts[i];
+                right_cost[i] = acc.half_area() * self.leaf_blocks(count);
+            }
+            let (mut acc, mut count) = (Aabb::EMPTY, 0);
+            for i in 0..BINS - 1 {
+                acc.grow(&bins[i].lo, &bins[i].hi);
+                count += counts[i];
+                let cost = acc.half_area() * self.leaf_blocks(count) + right_cost[i + 1];
+                if count > 0 && count < n && best.is_none_or(|b| cost < b.0) {
+                    best = Some((cost, axis, i));
+                }
+            }
+        }
+        let leaf_cost = self.leaf_blocks(n);
+        match best {
+            Some((cost, axis, last)) => {
+                let area = bounds.half_area();
+                let split_cost = if area > 0.0 {
+                    TRAVERSAL_COST + cost / area
+                } else {
+                    f32::INFINITY
+                };
+                if !must_split && split_cost >= leaf_cost {
+                    return None;
+                }
+                let (lo, hi) = (centers.lo[axis], centers.hi[axis]);
+                let scale = BINS as f32 / (hi - lo);
+                let mid = partition(items, |it| {
+                    ((((it.center2(axis) - lo) * scale) as usize).min(BINS - 1)) <= last
+                });
+                Some(mid)
+            }
+            // Every centroid coincides: halve the run to keep leaves small.
+            None if must_split => Some(n / 2),
+            None => None,
+        }
+    }
+
+    /// Cost of testing `n` items in leaves.
+    fn leaf_blocks(&self, n: usize) -> f32 {
+        n.div_ceil(self.block) as f32
+    }
+}
+
+fn items_len(slices: &[(&mut [Item], usize)]) -> usize {
+    slices.iter().map(|(s, _)| s.len()).sum()
 }
 
 /// Moves the items satisfying `pred` to the front; returns how many there are.
@@ -242,53 +432,4 @@ fn partition<T>(items: &mut [T], pred: impl Fn(&T) -> bool) -> usize {
         }
     }
     first
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::geometry::Sphere;
-
-    #[test]
-    fn finds_the_same_nearest_hit_as_brute_force() {
-        // A seeded cloud of spheres; compare with testing every sphere.
-        let mut state = 12345u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let spheres: Vec<Sphere> = (0..500)
-            .map(|_| {
-                Sphere::new(
-                    Vec3::new(next() * 20.0 - 10.0, next() * 20.0 - 10.0, next() * 20.0),
-                    0.05 + next() * 0.5,
-                )
-            })
-            .collect();
-        let bvh = Bvh::build(&spheres.iter().map(|s| s.bounds()).collect::<Vec<_>>());
-        for _ in 0..2000 {
-            let origin = Vec3::new(next() * 4.0 - 2.0, next() * 4.0 - 2.0, -5.0);
-            let dir = Vec3::new(next() - 0.5, next() - 0.5, 1.0);
-            let ray = Ray::new(origin, dir);
-            let fast = bvh.intersect(&ray, f64::INFINITY, |i, t| {
-                spheres[i as usize].intersect(&ray, t)
-            });
-            let brute = spheres
-                .iter()
-                .enumerate()
-                .filter_map(|(i, s)| s.intersect(&ray, f64::INFINITY).map(|h| (i as u32, h)))
-                .min_by(|a, b| a.1.t.total_cmp(&b.1.t));
-            assert_eq!(fast.map(|h| h.0), brute.map(|h| h.0));
-        }
-    }
-
-    #[test]
-    fn empty_bvh_misses() {
-        let bvh = Bvh::build(&[]);
-        assert!(bvh
-            .intersect(&Ray::new(Vec3::ZERO, Vec3::Z), 1.0, |_, _| unreachable!())
-            .is_none());
-    }
 }

@@ -1,6 +1,156 @@
-//! Acceleration structures. A bounding-volume hierarchy serves both levels of the scene: the
-//! primitives of a scene, and the triangles inside each mesh.
+//! Acceleration structures, selectable so their speed-ups can be compared: a four-wide BVH
+//! (the default), a uniform grid, an octree, and none (brute force). The same structures
+//! serve both levels of a scene: the primitives of the scene, and the triangles inside each
+//! mesh.
+//!
+//! Every structure answers one query, [`Accel::traverse`]: it hands the caller runs of item
+//! indices whose boxes the ray crosses, roughly nearest first, and the caller tests them,
+//! shrinking the search distance as it finds hits. Closest-hit, any-hit and all-hits queries
+//! are all written with it.
 
+mod brute;
 mod bvh;
+mod grid;
+mod mailbox;
+mod octree;
+pub(crate) mod ray_f32;
+pub(crate) mod simd;
 
-pub use bvh::Bvh;
+pub use brute::BruteForce;
+pub use bvh::{Bvh, MAX_LEAF_ITEMS};
+pub use grid::Grid;
+pub use octree::Octree;
+
+use crate::math::{Bounds3, Ray};
+
+/// Which acceleration structure to build.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum AccelKind {
+    #[default]
+    Bvh,
+    Grid,
+    Octree,
+    /// Brute force with bounding spheres.
+    None,
+}
+
+impl AccelKind {
+    pub const ALL: [AccelKind; 4] = [
+        AccelKind::Bvh,
+        AccelKind::Grid,
+        AccelKind::Octree,
+        AccelKind::None,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            AccelKind::Bvh => "bvh",
+            AccelKind::Grid => "grid",
+            AccelKind::Octree => "octree",
+            AccelKind::None => "none",
+        }
+    }
+}
+
+impl std::fmt::Display for AccelKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for AccelKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        AccelKind::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| format!("unknown accelerator `{s}`: expected bvh, grid, octree or none"))
+    }
+}
+
+/// How the caller tests a leaf's items: at most `max_leaf` per BVH leaf, `block` at a time
+/// (four triangles share one SIMD test).
+#[derive(Clone, Copy, Debug)]
+pub struct LeafSize {
+    pub max_leaf: usize,
+    pub block: usize,
+}
+
+impl LeafSize {
+    /// Items tested one by one (scene primitives).
+    pub const SINGLE: LeafSize = LeafSize {
+        max_leaf: 4,
+        block: 1,
+    };
+}
+
+#[derive(Clone, Debug)]
+pub enum Accel {
+    Bvh(Bvh),
+    Grid(Grid),
+    Octree(Octree),
+    None(BruteForce),
+}
+
+impl Default for Accel {
+    fn default() -> Self {
+        Accel::Bvh(Bvh::default())
+    }
+}
+
+impl Accel {
+    /// Builds a `kind` structure over items given by their bounds (empty boxes are never
+    /// returned by traversal).
+    pub fn build(kind: AccelKind, item_bounds: &[Bounds3], leaf: LeafSize) -> Accel {
+        match kind {
+            AccelKind::Bvh => Accel::Bvh(Bvh::build(item_bounds, leaf.max_leaf, leaf.block)),
+            AccelKind::Grid => Accel::Grid(Grid::build(item_bounds)),
+            AccelKind::Octree => Accel::Octree(Octree::build(item_bounds)),
+            AccelKind::None => Accel::None(BruteForce::build(item_bounds)),
+        }
+    }
+
+    pub fn kind(&self) -> AccelKind {
+        match self {
+            Accel::Bvh(_) => AccelKind::Bvh,
+            Accel::Grid(_) => AccelKind::Grid,
+            Accel::Octree(_) => AccelKind::Octree,
+            Accel::None(_) => AccelKind::None,
+        }
+    }
+
+    /// Bounds of all items.
+    pub fn bounds(&self) -> Bounds3 {
+        match self {
+            Accel::Bvh(a) => a.bounds(),
+            Accel::Grid(a) => a.bounds(),
+            Accel::Octree(a) => a.bounds(),
+            Accel::None(a) => a.bounds(),
+        }
+    }
+
+    /// Bytes the structure itself occupies (nodes, cells and item lists).
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Accel>()
+            + match self {
+                Accel::Bvh(a) => a.memory_bytes(),
+                Accel::Grid(a) => a.memory_bytes(),
+                Accel::Octree(a) => a.memory_bytes(),
+                Accel::None(a) => a.memory_bytes(),
+            }
+    }
+
+    /// Hands `visit(items, t_max)` runs of items whose bounds the ray may meet in
+    /// (0, t_max), roughly nearest first. `visit` tests them, may lower `t_max` (to the
+    /// nearest hit so far) to prune what lies beyond, and returns false to stop. No item is
+    /// handed over twice for one ray.
+    #[inline]
+    pub fn traverse(&self, ray: &Ray, t_max: f64, visit: impl FnMut(&[u32], &mut f64) -> bool) {
+        match self {
+            Accel::Bvh(a) => a.traverse(ray, t_max, visit),
+            Accel::Grid(a) => a.traverse(ray, t_max, visit),
+            Accel::Octree(a) => a.traverse(ray, t_max, visit),
+            Accel::None(a) => a.traverse(ray, t_max, visit),
+        }
+    }
+}

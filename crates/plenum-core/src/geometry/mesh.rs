@@ -1,20 +1,34 @@
-//! Triangle meshes with their own BVH, intersected by the watertight ray–triangle test of
-//! Woop, Benthin and Wald (JCGT 2013): no ray slips through a shared edge or vertex.
-//! Error bounds follow pbrt-v4 §6.8.4.
+//! Triangle meshes with their own acceleration structure, intersected by the watertight
+//! ray–triangle test of Woop, Benthin and Wald (JCGT 2013): no ray slips through a shared
+//! edge or vertex. Vertices are stored in f32, like Embree and pbrt, and four triangles are
+//! tested at once in f32 SIMD; the rare hit exactly on an edge is settled in f64. Error
+//! bounds follow pbrt-v4 §6.8.4.
 
 use super::{HitRecord, SurfaceGeometry};
-use crate::accel::Bvh;
+use crate::accel::ray_f32::{gamma_f32, round_up};
+use crate::accel::simd::F4;
+use crate::accel::{Accel, AccelKind, LeafSize};
 use crate::math::{gamma, Bounds3, Ray, Vec3};
+
+/// Four triangles per SIMD test, up to two tests per BVH leaf.
+const LEAF: LeafSize = LeafSize {
+    max_leaf: 8,
+    block: 4,
+};
 
 #[derive(Clone, Debug)]
 pub struct TriangleMesh {
+    /// Positions, each coordinate exactly an f32 (the geometry the f32 test sees).
     positions: Vec<Vec3>,
+    /// The same positions packed for the SIMD test (the fourth lane is padding).
+    packed: Vec<[f32; 4]>,
     /// Per-vertex shading normals, or empty for flat shading.
     normals: Vec<Vec3>,
     /// Per-vertex texture coordinates, or empty.
     uvs: Vec<[f64; 2]>,
     triangles: Vec<[u32; 3]>,
-    bvh: Bvh,
+    accel: Accel,
+    bounds: Bounds3,
     /// Every edge joins exactly two triangles: the mesh bounds a solid.
     closed: bool,
 }
@@ -89,20 +103,73 @@ impl TriangleMesh {
                 });
             }
         }
-        let bounds: Vec<Bounds3> = triangles
+        let positions: Vec<Vec3> = positions
             .iter()
-            .map(|t| Bounds3::from_points(t.iter().map(|&i| positions[i as usize])))
+            .map(|p| Vec3::new(p.x as f32 as f64, p.y as f32 as f64, p.z as f32 as f64))
             .collect();
-        let bvh = Bvh::build(&bounds);
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(MeshError::NonFinitePosition(i));
+        }
+        let packed = positions
+            .iter()
+            .map(|p| [p.x as f32, p.y as f32, p.z as f32, 0.0])
+            .collect();
         let closed = is_closed(&positions, &triangles);
-        Ok(TriangleMesh {
+        let mut mesh = TriangleMesh {
+            bounds: Bounds3::from_points(positions.iter().copied()),
             positions,
+            packed,
             normals,
             uvs,
             triangles,
-            bvh,
+            accel: Accel::default(),
             closed,
-        })
+        };
+        mesh.accel = Accel::build(AccelKind::Bvh, &mesh.triangle_bounds(), LEAF);
+        Ok(mesh)
+    }
+
+    /// The mesh with its triangles in a `kind` structure instead.
+    pub fn with_accel(&self, kind: AccelKind) -> TriangleMesh {
+        TriangleMesh {
+            accel: Accel::build(kind, &self.triangle_bounds(), LEAF),
+            ..self.clone_without_accel()
+        }
+    }
+
+    fn clone_without_accel(&self) -> TriangleMesh {
+        TriangleMesh {
+            positions: self.positions.clone(),
+            packed: self.packed.clone(),
+            normals: self.normals.clone(),
+            uvs: self.uvs.clone(),
+            triangles: self.triangles.clone(),
+            accel: Accel::default(),
+            bounds: self.bounds,
+            closed: self.closed,
+        }
+    }
+
+    fn triangle_bounds(&self) -> Vec<Bounds3> {
+        self.triangles
+            .iter()
+            .map(|t| Bounds3::from_points(t.iter().map(|&i| self.positions[i as usize])))
+            .collect()
+    }
+
+    pub fn accel(&self) -> &Accel {
+        &self.accel
+    }
+
+    /// Bytes the mesh occupies: vertices, indices, attributes and the acceleration structure.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<TriangleMesh>()
+            + self.positions.len() * std::mem::size_of::<Vec3>()
+            + self.packed.len() * std::mem::size_of::<[f32; 4]>()
+            + self.normals.len() * std::mem::size_of::<Vec3>()
+            + self.uvs.len() * std::mem::size_of::<[f64; 2]>()
+            + self.triangles.len() * std::mem::size_of::<[u32; 3]>()
+            + self.accel.memory_bytes()
     }
 
     pub fn is_closed(&self) -> bool {
@@ -136,24 +203,144 @@ impl TriangleMesh {
     }
 
     pub fn bounds(&self) -> Bounds3 {
-        self.bvh.bounds()
+        self.bounds
     }
 
     fn vertices(&self, index: u32) -> [Vec3; 3] {
         self.triangles[index as usize].map(|i| self.positions[i as usize])
     }
 
+    /// The nearest hit in (0, t_max).
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
-        self.bvh
-            .intersect(ray, t_max, |i, t_max| {
-                intersect_triangle(ray, t_max, self.vertices(i)).map(|(t, b1, b2)| HitRecord {
+        let sheared = ShearedRay::new(ray);
+        let mut best = None;
+        self.accel.traverse(ray, t_max, |items, t_max| {
+            for block in items.chunks(4) {
+                if let Some(hit) = self.intersect_block(&sheared, ray, block, *t_max) {
+                    *t_max = hit.t;
+                    best = Some(hit);
+                }
+            }
+            true
+        });
+        best
+    }
+
+    /// Some hit in (0, t_max), not necessarily the nearest: stops at the first one found.
+    pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
+        let sheared = ShearedRay::new(ray);
+        let mut found = None;
+        self.accel.traverse(ray, t_max, |items, t_max| {
+            found = items
+                .chunks(4)
+                .find_map(|block| self.intersect_block(&sheared, ray, block, *t_max));
+            found.is_none()
+        });
+        found
+    }
+
+    /// The nearest hit among up to four triangles, tested together.
+    #[inline]
+    fn intersect_block(
+        &self,
+        r: &ShearedRay,
+        ray: &Ray,
+        block: &[u32],
+        t_max: f64,
+    ) -> Option<HitRecord> {
+        // Gather the vertices, permuted so the ray runs along z, relative to the origin.
+        let mut v = [[[0.0f32; 4]; 3]; 3];
+        for lane in 0..4 {
+            let tri = self.triangles[block[lane.min(block.len() - 1)] as usize];
+            for k in 0..3 {
+                let p = &self.packed[tri[k] as usize];
+                v[k][0][lane] = p[r.axes[0]];
+                v[k][1][lane] = p[r.axes[1]];
+                v[k][2][lane] = p[r.axes[2]];
+            }
+        }
+        let lanes = (1u32 << block.len()) - 1;
+        let [a, b, c] = v.map(|p| {
+            let x = F4::from_array(p[0]).sub(r.origin[0]);
+            let y = F4::from_array(p[1]).sub(r.origin[1]);
+            let z = F4::from_array(p[2]).sub(r.origin[2]);
+            // Shear so the ray is the +z axis.
+            [x.add(r.shear[0].mul(z)), y.add(r.shear[1].mul(z)), z]
+        });
+        let e0 = b[0].mul(c[1]).sub(b[1].mul(c[0]));
+        let e1 = c[0].mul(a[1]).sub(c[1].mul(a[0]));
+        let e2 = a[0].mul(b[1]).sub(a[1].mul(b[0]));
+        let zero = F4::splat(0.0);
+        let negative = e0.lt(zero) | e1.lt(zero) | e2.lt(zero);
+        let positive = zero.lt(e0) | zero.lt(e1) | zero.lt(e2);
+        let mut inside = !(negative & positive) & lanes;
+        if inside == 0 {
+            return None;
+        }
+        // An edge function exactly zero in f32 may be a rounding artefact: settle in f64.
+        let on_edge = (e0.eq(zero) | e1.eq(zero) | e2.eq(zero)) & inside;
+        inside &= !on_edge;
+        let det = e0.add(e1).add(e2);
+        let sz = r.shear[2];
+        let (az, bz, cz) = (a[2].mul(sz), b[2].mul(sz), c[2].mul(sz));
+        let t_scaled = e0.mul(az).add(e1.mul(bz)).add(e2.mul(cz));
+        let t = t_scaled.div(det);
+        let limit = F4::splat(round_up(t_max));
+        inside &= zero.lt(t) & t.lt(limit) & !det.eq(zero);
+        let mut best: Option<HitRecord> = None;
+        if inside != 0 {
+            // Is t conservatively positive? (pbrt-v4 §6.8.4, in f32.)
+            let max3 = |p: F4, q: F4, s: F4| p.abs().max(q.abs()).max(s.abs());
+            let max_z = max3(az, bz, cz);
+            let max_x = max3(a[0], b[0], c[0]);
+            let max_y = max3(a[1], b[1], c[1]);
+            let delta_z = max_z.mul(F4::splat(gamma_f32(3)));
+            let delta_x = max_x.add(max_z).mul(F4::splat(gamma_f32(5)));
+            let delta_y = max_y.add(max_z).mul(F4::splat(gamma_f32(5)));
+            let delta_e = max_x
+                .mul(max_y)
+                .mul(F4::splat(gamma_f32(2)))
+                .add(delta_y.mul(max_x))
+                .add(delta_x.mul(max_y))
+                .mul(F4::splat(2.0));
+            let max_e = max3(e0, e1, e2);
+            let delta_t = max_e
+                .mul(max_z)
+                .mul(F4::splat(gamma_f32(3)))
+                .add(delta_e.mul(max_z))
+                .add(delta_z.mul(max_e))
+                .mul(F4::splat(3.0))
+                .div(det.abs());
+            inside &= delta_t.lt(t);
+            let (t, e1, e2, det) = (t.to_array(), e1.to_array(), e2.to_array(), det.to_array());
+            while inside != 0 {
+                let lane = inside.trailing_zeros() as usize;
+                inside &= inside - 1;
+                if best.is_none_or(|h| (t[lane] as f64) < h.t) {
+                    best = Some(HitRecord {
+                        t: t[lane] as f64,
+                        u: (e1[lane] / det[lane]) as f64,
+                        v: (e2[lane] / det[lane]) as f64,
+                        part: block[lane],
+                    });
+                }
+            }
+        }
+        let mut on_edge = on_edge;
+        while on_edge != 0 {
+            let lane = on_edge.trailing_zeros() as usize;
+            on_edge &= on_edge - 1;
+            let limit = best.map_or(t_max, |h| h.t);
+            if let Some((t, b1, b2)) = intersect_triangle(ray, limit, self.vertices(block[lane])) {
+                best = Some(HitRecord {
                     t,
                     u: b1,
                     v: b2,
-                    part: i,
-                })
-            })
-            .map(|(_, hit)| hit)
+                    part: block[lane],
+                });
+            }
+        }
+        best
     }
 
     pub fn surface(&self, _ray: &Ray, hit: &HitRecord) -> SurfaceGeometry {
@@ -161,7 +348,9 @@ impl TriangleMesh {
         let (b1, b2) = (hit.u, hit.v);
         let b0 = 1.0 - b1 - b2;
         let p = p0 * b0 + p1 * b1 + p2 * b2;
-        let p_error = ((p0 * b0).abs() + (p1 * b1).abs() + (p2 * b2).abs()) * gamma(7);
+        // Bounded as if computed in f32: a ray leaving the point is then tested in f32 from
+        // an origin rounded to f32, and must stay clear of the triangle it leaves.
+        let p_error = ((p0 * b0).abs() + (p1 * b1).abs() + (p2 * b2).abs()) * gamma_f32(7) as f64;
         let mut n = (p1 - p0).cross(p2 - p0).normalized();
         let idx = self.triangles[hit.part as usize];
         let shading_n = if self.normals.is_empty() {
@@ -192,6 +381,32 @@ impl TriangleMesh {
             n,
             shading_n,
             uv,
+        }
+    }
+}
+
+/// A ray prepared for the watertight test: axes permuted so the direction's largest
+/// component is z, and the shear that turns the ray into the +z axis (all in f32).
+struct ShearedRay {
+    axes: [usize; 3],
+    origin: [F4; 3],
+    shear: [F4; 3],
+}
+
+impl ShearedRay {
+    fn new(ray: &Ray) -> ShearedRay {
+        let kz = ray.direction.max_abs_axis();
+        let kx = (kz + 1) % 3;
+        let ky = (kx + 1) % 3;
+        let d = [kx, ky, kz].map(|a| ray.direction[a] as f32);
+        ShearedRay {
+            axes: [kx, ky, kz],
+            origin: [kx, ky, kz].map(|a| F4::splat(ray.origin[a] as f32)),
+            shear: [
+                F4::splat(-d[0] / d[2]),
+                F4::splat(-d[1] / d[2]),
+                F4::splat(1.0 / d[2]),
+            ],
         }
     }
 }

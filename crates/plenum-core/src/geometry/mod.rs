@@ -101,6 +101,15 @@ impl Shape {
         }
     }
 
+    /// Some hit in (0, t_max), not necessarily the nearest: enough for a shadow ray that
+    /// only asks whether the shape is in the way. Meshes stop at their first hit.
+    pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
+        match self {
+            Shape::Mesh(s) => s.intersect_any(ray, t_max),
+            _ => self.intersect(ray, t_max),
+        }
+    }
+
     /// The geometry at a hit. Texture coordinates cost trigonometry on curved shapes, so
     /// they are computed only when `want_uv` is set (otherwise they may be zero).
     pub fn surface(&self, ray: &Ray, hit: &HitRecord, want_uv: bool) -> SurfaceGeometry {

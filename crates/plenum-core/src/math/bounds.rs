@@ -90,6 +90,20 @@ impl Bounds3 {
     /// The parametric interval where the ray is inside the box, clipped to (0, t_max).
     /// `inv_dir` is 1/direction per axis. The far distance is widened by 2γ₃ so that
     /// rounding never makes the slab test miss a hit (pbrt-v4 §6.1.2).
+    /// [`Bounds3::intersect`] for a single test, computing the reciprocal direction.
+    pub fn intersect_interval(&self, ray: &Ray, t_max: f64) -> Option<(f64, f64)> {
+        let d = ray.direction;
+        self.intersect(ray, Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z), t_max)
+    }
+
+    /// The box grown by `margin` on every side.
+    pub fn expanded(&self, margin: f64) -> Bounds3 {
+        Bounds3 {
+            min: self.min - Vec3::splat(margin),
+            max: self.max + Vec3::splat(margin),
+        }
+    }
+
     pub fn intersect(&self, ray: &Ray, inv_dir: Vec3, t_max: f64) -> Option<(f64, f64)> {
         let mut t0 = 0.0f64;
         let mut t1 = t_max;
