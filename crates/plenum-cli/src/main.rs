@@ -3,6 +3,7 @@
 //! Exit codes: 0 success; 1 an output file could not be written; 2 bad input (a scene error,
 //! a bad argument); 130 interrupted by Ctrl-C, after writing what was rendered.
 
+mod bench;
 mod trace;
 
 use clap::{Args, Parser, Subcommand};
@@ -33,6 +34,8 @@ enum Command {
     Render(RenderArgs),
     /// Print the ray tree of one pixel: every ray traced for it and why each branch ended.
     TracePixel(TracePixelArgs),
+    /// Measure an acceleration structure on a rays file: build time, memory, Mrays/s.
+    Bench(bench::BenchArgs),
     /// Write any scene Plenum reads (.toml, .nff, .ray, .obj, .ply) in the native format.
     Convert(ConvertArgs),
 }
@@ -122,6 +125,7 @@ fn main() -> ExitCode {
         Command::Render(args) => run_render(args),
         Command::TracePixel(args) => trace::run(args),
         Command::Convert(args) => convert(args),
+        Command::Bench(args) => bench::run(args),
     }
 }
 

@@ -237,6 +237,28 @@ impl Scene {
         hit
     }
 
+    /// The scene with its primitives, and the triangles of every mesh, in `kind` structures.
+    pub fn with_accel(mut self, kind: AccelKind) -> Scene {
+        // Rebuild each distinct mesh once, so instances stay shared.
+        let mut rebuilt: std::collections::HashMap<*const TriangleMesh, Arc<TriangleMesh>> =
+            Default::default();
+        for p in &mut self.primitives {
+            if let Shape::Mesh(m) = &mut p.shape {
+                let new = rebuilt
+                    .entry(Arc::as_ptr(m))
+                    .or_insert_with(|| Arc::new(m.with_accel(kind)));
+                *m = new.clone();
+            }
+        }
+        let bounds: Vec<Bounds3> = self
+            .bounded
+            .iter()
+            .filter_map(|&i| self.primitives[i as usize].world_bounds())
+            .collect();
+        self.accel = Accel::build(kind, &bounds, LeafSize::SINGLE);
+        self
+    }
+
     /// Which structure holds the primitives (and the triangles of every mesh).
     pub fn accel_kind(&self) -> AccelKind {
         self.accel.kind()
@@ -359,20 +381,6 @@ impl SceneBuilder {
 
     /// Builds the scene with `kind` structures, over its primitives and inside its meshes.
     pub fn build_with(mut self, kind: AccelKind) -> Scene {
-        if kind != AccelKind::Bvh {
-            // Meshes come with a BVH; rebuild each distinct one once, keeping instances shared.
-            let mut rebuilt: std::collections::HashMap<*const TriangleMesh, Arc<TriangleMesh>> =
-                Default::default();
-            for p in &mut self.primitives {
-                if let Shape::Mesh(m) = &mut p.shape {
-                    let key = Arc::as_ptr(m);
-                    let new = rebuilt
-                        .entry(key)
-                        .or_insert_with(|| Arc::new(m.with_accel(kind)));
-                    *m = new.clone();
-                }
-            }
-        }
         // An opaque polyhedron is never entered, so its back faces can be culled.
         for p in &mut self.primitives {
             if let Shape::Polyhedron(poly) = &mut p.shape {
@@ -409,11 +417,11 @@ impl SceneBuilder {
                 None => self.materials[p.material as usize].needs_uv(),
             })
             .collect();
-        Scene {
+        let scene = Scene {
             transmissive,
             needs_uv,
             camera: self.camera,
-            accel: Accel::build(kind, &bounds, LeafSize::SINGLE),
+            accel: Accel::build(AccelKind::Bvh, &bounds, LeafSize::SINGLE),
             bounded,
             unbounded,
             primitives: self.primitives,
@@ -424,6 +432,11 @@ impl SceneBuilder {
             light_names: self.light_names,
             ambient: self.ambient,
             background: self.background,
+        };
+        if kind == AccelKind::Bvh {
+            scene
+        } else {
+            scene.with_accel(kind)
         }
     }
 }

@@ -9,6 +9,7 @@ mod nff;
 mod obj;
 mod ply;
 mod ray;
+pub mod ray_files;
 mod reader;
 mod writer;
 
@@ -52,6 +53,29 @@ pub struct LoadedScene {
     pub defaults: RenderDefaults,
     /// Harmless problems read past (unknown fields of imported formats), one line each.
     pub warnings: Vec<String>,
+}
+
+/// Reads a mesh file (`.obj` or `.ply`) as one mesh, triangles in file order (polygons
+/// fanned from their first vertex), as the shared benchmark files number them.
+pub fn load_mesh(path: &Path) -> Result<plenum_core::geometry::TriangleMesh, SceneError> {
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match extension.as_str() {
+        "ply" => ply::load_ply(path),
+        "obj" => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| SceneError::file(path, format!("cannot read the mesh file: {e}")))?;
+            let mut model = obj::parse_obj_model(path, &text, false)?;
+            Ok(model.groups.remove(0).1)
+        }
+        _ => Err(SceneError::file(
+            path,
+            "not a mesh file: expected .obj or .ply".to_string(),
+        )),
+    }
 }
 
 /// Reads a scene file, choosing the format by extension: `.nff` (Haines' Neutral File

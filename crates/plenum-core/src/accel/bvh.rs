@@ -15,6 +15,7 @@
 use super::ray_f32::{round_down, round_up, BoxRay};
 use super::simd::F4;
 use crate::math::{Bounds3, Ray};
+use std::mem::MaybeUninit;
 
 const BINS: usize = 16;
 /// Deepest binary split; bounds the traversal stack (three entries per level at most).
@@ -33,9 +34,10 @@ const START_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 pub const MAX_LEAF_ITEMS: usize = 15;
 const EMPTY: u32 = LEAF_BIT;
 
-/// Four child boxes as six planes of four lanes: min x, y, z then max x, y, z.
+/// Four child boxes as six planes of four lanes: min x, y, z then max x, y, z. Two cache
+/// lines exactly.
 #[derive(Clone, Debug)]
-#[repr(C, align(16))]
+#[repr(C, align(64))]
 struct Node {
     planes: [[f32; 4]; 6],
     children: [u32; 4],
@@ -215,7 +217,8 @@ impl Bvh {
         let r = BoxRay::new(ray);
         let mut t_max = t_max;
         let mut far = F4::splat(round_up(t_max));
-        let mut stack = [(0u32, 0f32); STACK];
+        // Uninitialised: only entries below `top`, all written first, are read.
+        let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK];
         let mut top = 0usize;
         let mut current = 0u32;
         loop {
@@ -250,11 +253,12 @@ impl Bvh {
                         }
                         // Insert keeping [base, top) sorted by decreasing distance.
                         let mut j = top;
-                        while j > base && stack[j - 1].1 < entry.1 {
+                        // SAFETY: entries in [base, top) were written above.
+                        while j > base && unsafe { stack[j - 1].assume_init() }.1 < entry.1 {
                             stack[j] = stack[j - 1];
                             j -= 1;
                         }
-                        stack[j] = entry;
+                        stack[j].write(entry);
                         top += 1;
                     }
                     current = best.0;
@@ -268,7 +272,8 @@ impl Bvh {
                     return;
                 }
                 top -= 1;
-                let (next, near) = stack[top];
+                // SAFETY: entries below `top` were written when pushed.
+                let (next, near) = unsafe { stack[top].assume_init() };
                 if near <= limit {
                     current = next;
                     break;

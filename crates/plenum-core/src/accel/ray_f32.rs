@@ -67,7 +67,9 @@ impl BoxRay {
                 d
             };
             let inv = (1.0 / d) as f32;
-            let (lo, hi) = (round_down(ray.origin[a]), round_up(ray.origin[a]));
+            // One ulp either side brackets the f64 origin without comparing.
+            let o = ray.origin[a] as f32;
+            let (lo, hi) = (o.next_down(), o.next_up());
             if inv >= 0.0 {
                 near_plane[a] = a;
                 far_plane[a] = 3 + a;

@@ -131,10 +131,14 @@ impl TriangleMesh {
 
     /// The mesh with its triangles in a `kind` structure instead.
     pub fn with_accel(&self, kind: AccelKind) -> TriangleMesh {
-        TriangleMesh {
-            accel: Accel::build(kind, &self.triangle_bounds(), LEAF),
-            ..self.clone_without_accel()
-        }
+        let mut mesh = self.clone_without_accel();
+        mesh.set_accel(kind);
+        mesh
+    }
+
+    /// Rebuilds the triangles' structure as a `kind` one.
+    pub fn set_accel(&mut self, kind: AccelKind) {
+        self.accel = Accel::build(kind, &self.triangle_bounds(), LEAF);
     }
 
     fn clone_without_accel(&self) -> TriangleMesh {
@@ -240,7 +244,7 @@ impl TriangleMesh {
     }
 
     /// The nearest hit among up to four triangles, tested together.
-    #[inline]
+    #[inline(always)]
     fn intersect_block(
         &self,
         r: &ShearedRay,
@@ -248,25 +252,39 @@ impl TriangleMesh {
         block: &[u32],
         t_max: f64,
     ) -> Option<HitRecord> {
-        // Gather the vertices, permuted so the ray runs along z, relative to the origin.
-        let mut v = [[[0.0f32; 4]; 3]; 3];
-        for lane in 0..4 {
-            let tri = self.triangles[block[lane.min(block.len() - 1)] as usize];
-            for k in 0..3 {
-                let p = &self.packed[tri[k] as usize];
-                v[k][0][lane] = p[r.axes[0]];
-                v[k][1][lane] = p[r.axes[1]];
-                v[k][2][lane] = p[r.axes[2]];
-            }
+        // One copy of the test per axis the ray runs along, so the permutation is static.
+        match r.axes[2] {
+            0 => self.intersect_block_along::<0>(r, ray, block, t_max),
+            1 => self.intersect_block_along::<1>(r, ray, block, t_max),
+            _ => self.intersect_block_along::<2>(r, ray, block, t_max),
         }
-        let lanes = (1u32 << block.len()) - 1;
-        let [a, b, c] = v.map(|p| {
-            let x = F4::from_array(p[0]).sub(r.origin[0]);
-            let y = F4::from_array(p[1]).sub(r.origin[1]);
-            let z = F4::from_array(p[2]).sub(r.origin[2]);
+    }
+
+    #[inline(always)]
+    fn intersect_block_along<const KZ: usize>(
+        &self,
+        r: &ShearedRay,
+        ray: &Ray,
+        block: &[u32],
+        t_max: f64,
+    ) -> Option<HitRecord> {
+        let (kx, ky) = ((KZ + 1) % 3, (KZ + 2) % 3);
+        // Gather the corners of four triangles (repeating the last for a short block) and
+        // turn them into lanes: one vector per coordinate of each corner.
+        let last = block.len() - 1;
+        let tri = |lane: usize| &self.triangles[block[lane.min(last)] as usize];
+        let (t0, t1, t2, t3) = (tri(0), tri(1), tri(2), tri(3));
+        let corner = |k: usize| {
+            let p = |t: &[u32; 3]| F4::load(&self.packed[t[k] as usize]);
+            let p = F4::transpose([p(t0), p(t1), p(t2), p(t3)]);
+            let x = p[kx].sub(r.origin[0]);
+            let y = p[ky].sub(r.origin[1]);
+            let z = p[KZ].sub(r.origin[2]);
             // Shear so the ray is the +z axis.
             [x.add(r.shear[0].mul(z)), y.add(r.shear[1].mul(z)), z]
-        });
+        };
+        let (a, b, c) = (corner(0), corner(1), corner(2));
+        let lanes = (1u32 << block.len()) - 1;
         let e0 = b[0].mul(c[1]).sub(b[1].mul(c[0]));
         let e1 = c[0].mul(a[1]).sub(c[1].mul(a[0]));
         let e2 = a[0].mul(b[1]).sub(a[1].mul(b[0]));
