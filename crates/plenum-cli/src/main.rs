@@ -7,6 +7,7 @@ mod bench;
 mod trace;
 
 use clap::{Args, Parser, Subcommand};
+use plenum_core::accel::AccelKind;
 use plenum_core::integrator::{WhittedConfig, MAX_DEPTH};
 use plenum_core::render::{render, RenderSettings};
 use plenum_core::sampling::{PixelSampler, MAX_SPP};
@@ -87,6 +88,9 @@ struct RenderArgs {
     /// Exposure in stops, for PNG output.
     #[arg(long)]
     exposure: Option<f64>,
+    /// Acceleration structure: bvh (default), grid, octree or none (brute force).
+    #[arg(long, default_value = "bvh")]
+    accel: AccelKind,
     /// No progress bar and no summary.
     #[arg(short, long)]
     quiet: bool,
@@ -212,6 +216,18 @@ fn run_render(args: RenderArgs) -> ExitCode {
         Ok(l) => l,
         Err(code) => return code,
     };
+    if args.accel != AccelKind::Bvh {
+        let LoadedScene {
+            scene,
+            defaults,
+            warnings,
+        } = loaded;
+        loaded = LoadedScene {
+            scene: scene.with_accel(args.accel),
+            defaults,
+            warnings,
+        };
+    }
     let load_seconds = load_start.elapsed().as_secs_f64();
     let settings = match settings(&args.view, &mut loaded) {
         Ok(s) => s,

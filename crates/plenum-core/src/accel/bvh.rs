@@ -41,6 +41,8 @@ const EMPTY: u32 = LEAF_BIT;
 struct Node {
     planes: [[f32; 4]; 6],
     children: [u32; 4],
+    /// Bit i set where child slot i is used.
+    used: u32,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -187,6 +189,7 @@ impl Bvh {
                 [f32::NEG_INFINITY; 4],
             ],
             children: [EMPTY; 4],
+            used: (1 << children.len()) - 1,
         };
         for (slot, child) in children.iter().enumerate() {
             let b = child.bounds();
@@ -231,7 +234,8 @@ impl Bvh {
                 far = F4::splat(round_up(t_max));
             } else {
                 let node = &self.nodes[current as usize];
-                let (near, mut hits) = r.test4(&node.planes, far);
+                let (near, hits) = r.test4(&node.planes, far);
+                let mut hits = hits & node.used;
                 if hits != 0 {
                     let near = near.to_array();
                     // The nearest hit child is visited next; the others wait on the stack,

@@ -7,7 +7,7 @@ use super::mailbox::{new_owner, Mailbox};
 use crate::math::{Bounds3, Ray, Vec3};
 
 /// Cells per item.
-const LAMBDA: f64 = 4.0;
+const LAMBDA: f64 = 1.5;
 const MAX_RESOLUTION: usize = 512;
 /// Candidates handed to the caller at a time.
 const CHUNK: usize = 16;

@@ -115,8 +115,9 @@ impl Octree {
                 }
             }
         }
-        // Items that all straddle the centre: splitting would only copy them.
-        if children.iter().all(|c| c.len() == items.len()) {
+        // Items that mostly straddle the centre: splitting would only copy them.
+        let copies: usize = children.iter().map(Vec::len).sum();
+        if copies > 4 * items.len() || children.iter().all(|c| c.len() == items.len()) {
             return make_leaf(self, &items);
         }
         let first = self.nodes.len();

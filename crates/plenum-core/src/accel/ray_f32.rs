@@ -36,13 +36,11 @@ pub fn round_up(x: f64) -> f32 {
 
 /// A ray prepared for slab tests against four boxes at once.
 pub struct BoxRay {
-    /// Per axis, the plane (0–5: min x, y, z, max x, y, z) the ray enters and leaves by.
-    near_plane: [usize; 3],
-    far_plane: [usize; 3],
-    /// The origin rounded so that entry distances are never overestimated and exit distances
-    /// never underestimated.
-    origin_near: [F4; 3],
-    origin_far: [F4; 3],
+    /// The origin rounded up, for the distances to min planes, and down, for max planes:
+    /// whichever of the two is the entry, it is never overestimated, and the exit never
+    /// underestimated, whatever the direction's sign.
+    origin_up: [F4; 3],
+    origin_down: [F4; 3],
     inv_dir: [F4; 3],
 }
 
@@ -52,43 +50,28 @@ const FAR_SCALE: f32 = 1.0 + 2.0 * gamma_f32(5);
 
 impl BoxRay {
     pub fn new(ray: &Ray) -> BoxRay {
-        let mut near_plane = [0; 3];
-        let mut far_plane = [0; 3];
-        let mut origin_near = [F4::splat(0.0); 3];
-        let mut origin_far = [F4::splat(0.0); 3];
-        let mut inv_dir = [F4::splat(0.0); 3];
-        for a in 0..3 {
-            let d = ray.direction[a];
+        let axis = |a: usize| {
             // A zero component would make 0·∞ = NaN at a plane through the origin; a tiny
             // one gives the same answer without it.
+            let d = ray.direction[a];
             let d = if d.abs() < 1e-30 {
                 1e-30f64.copysign(d)
             } else {
                 d
             };
-            let inv = (1.0 / d) as f32;
             // One ulp either side brackets the f64 origin without comparing.
             let o = ray.origin[a] as f32;
-            let (lo, hi) = (o.next_down(), o.next_up());
-            if inv >= 0.0 {
-                near_plane[a] = a;
-                far_plane[a] = 3 + a;
-                origin_near[a] = F4::splat(hi);
-                origin_far[a] = F4::splat(lo);
-            } else {
-                near_plane[a] = 3 + a;
-                far_plane[a] = a;
-                origin_near[a] = F4::splat(lo);
-                origin_far[a] = F4::splat(hi);
-            }
-            inv_dir[a] = F4::splat(inv);
-        }
+            (
+                F4::splat(o.next_up()),
+                F4::splat(o.next_down()),
+                F4::splat((1.0 / d) as f32),
+            )
+        };
+        let (x, y, z) = (axis(0), axis(1), axis(2));
         BoxRay {
-            near_plane,
-            far_plane,
-            origin_near,
-            origin_far,
-            inv_dir,
+            origin_up: [x.0, y.0, z.0],
+            origin_down: [x.1, y.1, z.1],
+            inv_dir: [x.2, y.2, z.2],
         }
     }
 
@@ -96,13 +79,13 @@ impl BoxRay {
     #[inline(always)]
     pub fn test4(&self, planes: &[[f32; 4]; 6], far: F4) -> (F4, u32) {
         let slab = |a: usize| {
-            let t0 = F4::load(&planes[self.near_plane[a]])
-                .sub(self.origin_near[a])
+            let t0 = F4::load(&planes[a])
+                .sub(self.origin_up[a])
                 .mul(self.inv_dir[a]);
-            let t1 = F4::load(&planes[self.far_plane[a]])
-                .sub(self.origin_far[a])
+            let t1 = F4::load(&planes[3 + a])
+                .sub(self.origin_down[a])
                 .mul(self.inv_dir[a]);
-            (t0, t1)
+            (t0.min(t1), t0.max(t1))
         };
         let (x0, x1) = slab(0);
         let (y0, y1) = slab(1);
