@@ -209,9 +209,9 @@ impl Octree {
             // The mid-planes crossed inside the cell, in order along the ray.
             let mut crossings = [(0.0f64, 0usize); 3];
             let mut n = 0;
-            for a in 0..3 {
-                if tm[a] > ta && tm[a] < tb {
-                    crossings[n] = (tm[a], a);
+            for (a, &t) in tm.iter().enumerate() {
+                if t > ta && t < tb {
+                    crossings[n] = (t, a);
                     n += 1;
                 }
             }
