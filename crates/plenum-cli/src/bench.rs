@@ -40,7 +40,7 @@ pub struct BenchArgs {
 
 /// What is traced: a mesh's triangles (hits name triangles) or a scene (hits name primitives).
 enum Target {
-    Mesh(TriangleMesh),
+    Mesh(Box<TriangleMesh>),
     Scene(Box<Scene>),
 }
 
@@ -127,7 +127,7 @@ pub fn run(args: BenchArgs) -> ExitCode {
                 let mut mesh = plenum_scene::load_mesh(&args.mesh)?;
                 let start = Instant::now();
                 mesh.set_accel(args.accel);
-                Ok((Target::Mesh(mesh), start.elapsed().as_secs_f64()))
+                Ok((Target::Mesh(Box::new(mesh)), start.elapsed().as_secs_f64()))
             } else {
                 let scene = plenum_scene::load_scene(&args.mesh)?.scene;
                 let start = Instant::now();
