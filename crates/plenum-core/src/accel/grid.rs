@@ -9,8 +9,6 @@ use crate::math::{Bounds3, Ray, Vec3};
 /// Cells per item.
 const LAMBDA: f64 = 1.5;
 const MAX_RESOLUTION: usize = 512;
-/// Candidates handed to the caller at a time.
-const CHUNK: usize = 16;
 
 #[derive(Clone, Debug)]
 pub struct Grid {
@@ -158,17 +156,12 @@ impl Grid {
             }
         }
         let mailbox = Mailbox::start(self.owner, self.item_count);
-        let mut buffer = [0u32; CHUNK];
         let [nx, ny, _] = self.resolution;
         loop {
             let c = (cell[2] * ny + cell[1]) * nx + cell[0];
-            let mut rest = &self.items[self.starts[c] as usize..self.starts[c + 1] as usize];
-            while !rest.is_empty() {
-                let (n, used) = mailbox.filter(rest, &mut buffer);
-                rest = &rest[used..];
-                if n > 0 && !visit(&buffer[..n], &mut t_max) {
-                    return;
-                }
+            let items = &self.items[self.starts[c] as usize..self.starts[c + 1] as usize];
+            if !mailbox.visit_untested(items, &mut t_max, &mut visit) {
+                return;
             }
             // Step to the neighbour across the nearest cell wall.
             let a = if next[0] < next[1] {

@@ -22,6 +22,9 @@ struct Stamps {
     used: u64,
 }
 
+/// Candidates handed to the caller at a time.
+const CHUNK: usize = 16;
+
 /// How many structures' stamps a thread keeps.
 const KEPT: usize = 32;
 
@@ -69,9 +72,29 @@ impl Mailbox {
         })
     }
 
+    /// Hands `visit` the items of `cell` this ray has not tested yet (see
+    /// [`super::Accel::traverse`]); returns false if `visit` asked to stop.
+    pub fn visit_untested(
+        &self,
+        cell: &[u32],
+        t_max: &mut f64,
+        visit: &mut impl FnMut(&[u32], &mut f64) -> bool,
+    ) -> bool {
+        let mut buffer = [0u32; CHUNK];
+        let mut rest = cell;
+        while !rest.is_empty() {
+            let (n, used) = self.filter(rest, &mut buffer);
+            rest = &rest[used..];
+            if n > 0 && !visit(&buffer[..n], t_max) {
+                return false;
+            }
+        }
+        true
+    }
+
     /// Copies to `out` the items of `cell` this ray has not tested yet, stamping them;
     /// returns how many were copied and how many of `cell` were consumed.
-    pub fn filter(&self, cell: &[u32], out: &mut [u32]) -> (usize, usize) {
+    fn filter(&self, cell: &[u32], out: &mut [u32]) -> (usize, usize) {
         MAILBOXES.with(|m| {
             let (clock, boxes) = &mut *m.borrow_mut();
             *clock += 1;

@@ -11,7 +11,6 @@ const LEAF_ITEMS: usize = 8;
 const MAX_DEPTH: usize = 16;
 /// A ray passes through at most four of a cell's children.
 const STACK: usize = 3 * MAX_DEPTH + 2;
-const CHUNK: usize = 16;
 
 #[derive(Clone, Debug)]
 struct OctNode {
@@ -170,7 +169,6 @@ impl Octree {
             1.0 / d
         });
         let mailbox = Mailbox::start(self.owner, self.item_count);
-        let mut buffer = [0u32; CHUNK];
         let mut stack = [(0u32, Vec3::ZERO, Vec3::ZERO, 0.0f64, 0.0f64); STACK];
         stack[0] = (0, self.bounds.min, self.bounds.max, t_enter, t_exit);
         let mut top = 1;
@@ -183,13 +181,9 @@ impl Octree {
             let node = &self.nodes[index as usize];
             if node.first_child == 0 {
                 let start = node.start as usize;
-                let mut rest = &self.items[start..start + node.count as usize];
-                while !rest.is_empty() {
-                    let (n, used) = mailbox.filter(rest, &mut buffer);
-                    rest = &rest[used..];
-                    if n > 0 && !visit(&buffer[..n], &mut t_max) {
-                        return;
-                    }
+                let items = &self.items[start..start + node.count as usize];
+                if !mailbox.visit_untested(items, &mut t_max, &mut visit) {
+                    return;
                 }
                 continue;
             }
