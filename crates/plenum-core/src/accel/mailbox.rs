@@ -36,6 +36,8 @@ thread_local! {
 pub struct Mailbox {
     owner: u64,
     ray: u32,
+    /// Where the stamps were when the ray started: checked, then used without a search.
+    slot: std::cell::Cell<usize>,
 }
 
 impl Mailbox {
@@ -68,7 +70,11 @@ impl Mailbox {
                 s.stamps.fill(0);
                 s.ray = 1;
             }
-            Mailbox { owner, ray: s.ray }
+            Mailbox {
+                owner,
+                ray: s.ray,
+                slot: std::cell::Cell::new(slot),
+            }
         })
     }
 
@@ -98,10 +104,15 @@ impl Mailbox {
         MAILBOXES.with(|m| {
             let (clock, boxes) = &mut *m.borrow_mut();
             *clock += 1;
-            let s = boxes
-                .iter_mut()
-                .find(|s| s.owner == self.owner && s.ray == self.ray);
-            let Some(s) = s else {
+            let ours = |s: &Stamps| s.owner == self.owner && s.ray == self.ray;
+            let slot = match boxes.get(self.slot.get()) {
+                Some(s) if ours(s) => Some(self.slot.get()),
+                _ => boxes.iter().position(ours),
+            };
+            let Some(s) = slot.map(|i| {
+                self.slot.set(i);
+                &mut boxes[i]
+            }) else {
                 // Our stamps were evicted by traversals nested in this one (more than
                 // `KEPT` structures in between): test everything rather than skip an item.
                 let n = cell.len().min(out.len());

@@ -6,6 +6,7 @@
 
 use super::mailbox::{new_owner, Mailbox};
 use crate::math::{Bounds3, Ray, Vec3};
+use std::mem::MaybeUninit;
 
 const LEAF_ITEMS: usize = 8;
 const MAX_DEPTH: usize = 16;
@@ -169,12 +170,14 @@ impl Octree {
             1.0 / d
         });
         let mailbox = Mailbox::start(self.owner, self.item_count);
-        let mut stack = [(0u32, Vec3::ZERO, Vec3::ZERO, 0.0f64, 0.0f64); STACK];
-        stack[0] = (0, self.bounds.min, self.bounds.max, t_enter, t_exit);
+        // Uninitialised: only entries below `top`, all written first, are read.
+        let mut stack = [MaybeUninit::<(u32, Vec3, Vec3, f64, f64)>::uninit(); STACK];
+        stack[0].write((0, self.bounds.min, self.bounds.max, t_enter, t_exit));
         let mut top = 1;
         while top > 0 {
             top -= 1;
-            let (index, lo, hi, ta, tb) = stack[top];
+            // SAFETY: entries below `top` were written when pushed.
+            let (index, lo, hi, ta, tb) = unsafe { stack[top].assume_init() };
             if ta > t_max {
                 continue;
             }
@@ -221,7 +224,7 @@ impl Octree {
             sequence[n] = (octant, t, tb);
             for &(oct, t0, t1) in sequence[..=n].iter().rev() {
                 let (clo, chi) = child_box(lo, hi, oct);
-                stack[top] = (node.first_child + oct as u32, clo, chi, t0, t1);
+                stack[top].write((node.first_child + oct as u32, clo, chi, t0, t1));
                 top += 1;
             }
         }
