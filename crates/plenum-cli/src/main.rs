@@ -10,7 +10,7 @@ use clap::{Args, Parser, Subcommand};
 use plenum_core::accel::AccelKind;
 use plenum_core::integrator::{WhittedConfig, MAX_DEPTH};
 use plenum_core::render::{render, RenderSettings};
-use plenum_core::sampling::{PixelSampler, MAX_SPP};
+use plenum_core::sampling::{PixelSampler, SamplerKind, MAX_SPP};
 use plenum_scene::{builtin_scene, load_scene, LoadedScene};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -58,9 +58,13 @@ struct ViewArgs {
     /// Image height in pixels.
     #[arg(long)]
     height: Option<u32>,
-    /// Samples per pixel, on a regular √N×√N grid.
+    /// Samples per pixel.
     #[arg(long)]
     spp: Option<u32>,
+    /// Where samples go in a pixel: grid (regular √N×√N), random (N uniform points) or
+    /// jittered (one uniform point in each cell of a √N×√N grid).
+    #[arg(long, default_value = "grid")]
+    sampler: SamplerKind,
     /// Maximum number of reflection/refraction bounces.
     #[arg(long)]
     max_depth: Option<u32>,
@@ -177,10 +181,15 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
         eprintln!("error: --max-depth must be at most {MAX_DEPTH}");
         return Err(ExitCode::from(2));
     }
-    let sampler = PixelSampler::grid_for(spp);
+    let sampler = PixelSampler::new(view.sampler, spp);
     if sampler.samples_per_pixel() != spp {
         eprintln!(
-            "warning: the regular grid needs a square sample count; using {} instead of {spp}",
+            "warning: the {} sampler needs a square sample count; using {} instead of {spp}",
+            if view.sampler == SamplerKind::Jittered {
+                "jittered"
+            } else {
+                "grid"
+            },
             sampler.samples_per_pixel()
         );
     }

@@ -6,5 +6,5 @@
 mod pixel;
 mod rng;
 
-pub use pixel::{PixelSampler, MAX_SPP};
+pub use pixel::{PixelSampler, SamplerKind, MAX_SPP};
 pub use rng::Rng;
