@@ -31,7 +31,7 @@ const LEAF_BIT: u32 = 1 << 31;
 const COUNT_SHIFT: u32 = 27;
 const START_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 /// Longest run a leaf can hold.
-pub const MAX_LEAF_ITEMS: usize = 15;
+const MAX_LEAF_ITEMS: usize = 15;
 const EMPTY: u32 = LEAF_BIT;
 
 /// Four child boxes as six planes of four lanes: min x, y, z then max x, y, z. Two cache
