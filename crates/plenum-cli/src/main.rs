@@ -9,8 +9,8 @@ mod trace;
 use clap::{Args, Parser, Subcommand};
 use plenum_core::accel::AccelKind;
 use plenum_core::integrator::{WhittedConfig, MAX_DEPTH};
-use plenum_core::render::{render, RenderSettings};
-use plenum_core::sampling::{PixelSampler, SamplerKind, MAX_SPP};
+use plenum_core::render::{render, Adaptive, RenderSettings, MAX_SUBDIVISION};
+use plenum_core::sampling::{Filter, FilterKind, PixelSampler, SamplerKind, MAX_SPP};
 use plenum_scene::{builtin_scene, load_scene, LoadedScene};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -61,10 +61,33 @@ struct ViewArgs {
     /// Samples per pixel.
     #[arg(long)]
     spp: Option<u32>,
-    /// Where samples go in a pixel: grid (regular √N×√N), random (N uniform points) or
-    /// jittered (one uniform point in each cell of a √N×√N grid).
+    /// Where samples go in a pixel (and on the lens, in time, over lights and glossy lobes):
+    /// grid (regular √N×√N), random (N uniform points), jittered (one point in each cell of a
+    /// √N×√N grid), cook16 (Cook's 16 correlated regions), sobol (Owen-scrambled Sobol) or
+    /// adaptive (Whitted's corner subdivision; with --noise-threshold, sampling until the
+    /// error estimate is below it, between --min-spp and --spp).
     #[arg(long, default_value = "grid")]
-    sampler: SamplerKind,
+    sampler: SamplerArg,
+    /// Reconstruction filter: box (the default), tent, gaussian, mitchell or lanczos.
+    #[arg(long)]
+    filter: Option<FilterKind>,
+    /// Filter radius in pixels (default: 0.5 box, 1 tent, 1.5 gaussian, 2 mitchell, 3 lanczos).
+    #[arg(long)]
+    filter_radius: Option<f64>,
+    /// Adaptive subdivision: split where corner luminances differ by more than this
+    /// contrast, (max − min)/(max + min).
+    #[arg(long, default_value_t = 0.05)]
+    contrast: f64,
+    /// Adaptive subdivision: the deepest level (1 to 4; 4 = 16×16 squares per pixel).
+    #[arg(long, default_value_t = 3)]
+    adaptive_depth: u32,
+    /// Adaptive sampling by variance: stop a pixel when the standard error of its luminance
+    /// is below this fraction of its mean (of 0.05 in dark pixels).
+    #[arg(long)]
+    noise_threshold: Option<f64>,
+    /// Adaptive sampling by variance: samples per pixel before the first check, and per batch.
+    #[arg(long, default_value_t = 16)]
+    min_spp: u32,
     /// Maximum number of reflection/refraction bounces.
     #[arg(long)]
     max_depth: Option<u32>,
@@ -113,6 +136,38 @@ struct TracePixelArgs {
     json: bool,
     #[command(flatten)]
     view: ViewArgs,
+}
+
+/// `--sampler`: a fixed-count pattern, or adaptive sampling.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum SamplerArg {
+    Fixed(SamplerKind),
+    Adaptive,
+}
+
+impl Default for SamplerArg {
+    fn default() -> Self {
+        SamplerArg::Fixed(SamplerKind::Grid)
+    }
+}
+
+impl std::str::FromStr for SamplerArg {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "adaptive" => Ok(SamplerArg::Adaptive),
+            _ => s.parse().map(SamplerArg::Fixed),
+        }
+    }
+}
+
+impl std::fmt::Display for SamplerArg {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        match self {
+            SamplerArg::Fixed(k) => write!(f, "{}", k.name()),
+            SamplerArg::Adaptive => write!(f, "adaptive"),
+        }
+    }
 }
 
 static CANCEL: AtomicBool = AtomicBool::new(false);
@@ -181,22 +236,74 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
         eprintln!("error: --max-depth must be at most {MAX_DEPTH}");
         return Err(ExitCode::from(2));
     }
-    let sampler = PixelSampler::new(view.sampler, spp);
+    let kind = match view.sampler {
+        SamplerArg::Fixed(kind) => kind,
+        SamplerArg::Adaptive => SamplerKind::Sobol,
+    };
+    let sampler = PixelSampler::new(kind, spp);
     if sampler.samples_per_pixel() != spp {
         eprintln!(
-            "warning: the {} sampler needs a square sample count; using {} instead of {spp}",
-            if view.sampler == SamplerKind::Jittered {
-                "jittered"
+            "warning: the {} sampler takes {}; using {} samples instead of {spp}",
+            view.sampler,
+            if kind == SamplerKind::Cook16 {
+                "multiples of 16"
             } else {
-                "grid"
+                "square sample counts"
             },
             sampler.samples_per_pixel()
         );
     }
+    let filter_kind = view.filter.unwrap_or(FilterKind::Box);
+    let filter = Filter::new(
+        filter_kind,
+        view.filter_radius.unwrap_or(filter_kind.default_radius()),
+    )
+    .map_err(|e| {
+        eprintln!("error: --filter-radius: {e}");
+        ExitCode::from(2)
+    })?;
+    let adaptive = match (view.sampler, view.noise_threshold) {
+        (SamplerArg::Fixed(_), Some(_)) => {
+            eprintln!("error: --noise-threshold needs --sampler adaptive");
+            return Err(ExitCode::from(2));
+        }
+        (SamplerArg::Fixed(_), None) => None,
+        (SamplerArg::Adaptive, Some(threshold)) => {
+            if !(threshold > 0.0 && threshold.is_finite()) {
+                eprintln!("error: --noise-threshold must be a positive number");
+                return Err(ExitCode::from(2));
+            }
+            if view.min_spp < 2 || view.min_spp > spp {
+                eprintln!("error: --min-spp must be between 2 and --spp ({spp})");
+                return Err(ExitCode::from(2));
+            }
+            Some(Adaptive::Variance {
+                threshold,
+                min_spp: view.min_spp,
+                max_spp: spp,
+            })
+        }
+        (SamplerArg::Adaptive, None) => {
+            if !(1..=MAX_SUBDIVISION).contains(&view.adaptive_depth) {
+                eprintln!("error: --adaptive-depth must be between 1 and {MAX_SUBDIVISION}");
+                return Err(ExitCode::from(2));
+            }
+            if !(view.contrast >= 0.0 && view.contrast.is_finite()) {
+                eprintln!("error: --contrast must be a number ≥ 0");
+                return Err(ExitCode::from(2));
+            }
+            Some(Adaptive::Subdivide {
+                contrast: view.contrast,
+                depth: view.adaptive_depth,
+            })
+        }
+    };
     Ok(RenderSettings {
         width,
         height,
         sampler,
+        filter,
+        adaptive,
         integrator: WhittedConfig {
             max_depth,
             min_weight: d.min_weight,
@@ -298,11 +405,11 @@ fn run_render(args: RenderArgs) -> ExitCode {
     if !args.quiet {
         let c = &output.counts;
         eprintln!(
-            "loaded in {:.3} s; {}×{}, {} spp, {:.3} s, rays: {} camera, {} shadow, {} reflection, {} refraction; {:.2} Mrays/s → {}",
+            "loaded in {:.3} s; {}×{}, {:.2} spp on average, {:.3} s, rays: {} camera, {} shadow, {} reflection, {} refraction; {:.2} Mrays/s → {}",
             load_seconds,
             film.width,
             film.height,
-            settings.sampler.samples_per_pixel(),
+            c.camera as f64 / (film.width as f64 * film.height as f64),
             elapsed,
             c.camera,
             c.shadow,

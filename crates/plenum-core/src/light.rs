@@ -1,8 +1,16 @@
-//! Lights of the Whitted model. Ambient light is not among them: the scene keeps one
-//! ambient colour I_a, the sum of the ambient lights its file declares.
+//! Lights. Point, directional and spot lights are Whitted's; area lights (rectangles, disks,
+//! spheres and triangle meshes that emit) are distribution ray tracing's: shadow rays go to
+//! points sampled over their area, so shadows get penumbrae. Ambient light is not among
+//! them: the scene keeps one ambient colour I_a, the sum of the ambient lights its file
+//! declares.
+//!
+//! Units: a point light's I_L reaches a surface undimmed unless an attenuation says otherwise
+//! (Whitted's convention), while an area light of radiance L_e gives the irradiance physics
+//! gives, ∫ L_e cos θ dω, which falls off with the square of the distance.
 
 use crate::color::Color;
 use crate::math::Vec3;
+use crate::sampling::{concentric_disk, uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_triangle, Frame};
 
 /// Distance attenuation f(d) = min(1, 1 / (a + b·d + c·d²)).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -54,6 +62,135 @@ pub enum Light {
         intensity: Color,
         attenuation: Attenuation,
     },
+    /// A surface that emits radiance `radiance` from every point, toward both sides.
+    Area {
+        shape: Emitter,
+        radiance: Color,
+        /// Shadow rays per shading point, stratified over the area (rounded up to a square).
+        samples: u32,
+    },
+}
+
+/// The surface of an area light, in world coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Emitter {
+    /// The parallelogram corner + a·edge_u + b·edge_v, a and b in [0, 1].
+    Rectangle {
+        corner: Vec3,
+        edge_u: Vec3,
+        edge_v: Vec3,
+    },
+    Disk {
+        center: Vec3,
+        normal: Vec3,
+        radius: f64,
+    },
+    Sphere { center: Vec3, radius: f64 },
+    /// Triangles, picked in proportion to their area.
+    Triangles {
+        triangles: Vec<[Vec3; 3]>,
+        /// Running sums of the triangles' areas, the last one the total.
+        cumulative_area: Vec<f64>,
+    },
+}
+
+impl Emitter {
+    /// An emitter made of world-space triangles; `None` when they have no area.
+    pub fn triangles(triangles: Vec<[Vec3; 3]>) -> Option<Emitter> {
+        let mut sum = 0.0;
+        let cumulative_area: Vec<f64> = triangles
+            .iter()
+            .map(|t| {
+                sum += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+                sum
+            })
+            .collect();
+        (sum > 0.0).then_some(Emitter::Triangles {
+            triangles,
+            cumulative_area,
+        })
+    }
+
+    pub fn area(&self) -> f64 {
+        match self {
+            Emitter::Rectangle { edge_u, edge_v, .. } => edge_u.cross(*edge_v).length(),
+            Emitter::Disk { radius, .. } => std::f64::consts::PI * radius * radius,
+            Emitter::Sphere { radius, .. } => 4.0 * std::f64::consts::PI * radius * radius,
+            Emitter::Triangles {
+                cumulative_area, ..
+            } => cumulative_area.last().copied().unwrap_or(0.0),
+        }
+    }
+
+    /// A point seen from `p`, its unit normal, and the pdf of choosing it with respect to
+    /// solid angle at `p` (the area pdf converted by d² / |cos θ_light|); `None` if the
+    /// sample sees the surface edge-on.
+    fn sample(&self, p: Vec3, u: [f64; 2]) -> Option<(Vec3, f64)> {
+        let (point, normal) = match self {
+            Emitter::Sphere { center, radius } => {
+                let to_center = *center - p;
+                let d2 = to_center.length_squared();
+                let r2 = radius * radius;
+                if d2 > r2 * (1.0 + 1e-9) {
+                    // Outside: sample the cone of directions the sphere fills, uniformly in
+                    // solid angle (the visible cap, without wasted samples on the far side).
+                    let d = d2.sqrt();
+                    let cos_max = ((d2 - r2).max(0.0)).sqrt() / d;
+                    let local = uniform_cone(u, cos_max);
+                    let w = Frame::from_z(to_center / d).to_world(local);
+                    // Nearest intersection of p + s·w with the sphere (s ≥ 0).
+                    let b = w.dot(to_center);
+                    let disc = (r2 - (d2 - b * b)).max(0.0);
+                    let s = b - disc.sqrt();
+                    return Some((p + w * s, uniform_cone_pdf(cos_max)));
+                }
+                let n = uniform_sphere(u);
+                (*center + n * *radius, n)
+            }
+            Emitter::Rectangle {
+                corner,
+                edge_u,
+                edge_v,
+            } => (
+                *corner + *edge_u * u[0] + *edge_v * u[1],
+                edge_u.cross(*edge_v).normalized(),
+            ),
+            Emitter::Disk {
+                center,
+                normal,
+                radius,
+            } => {
+                let (x, y) = concentric_disk(u);
+                let (s, t) = normal.orthonormal_basis();
+                (*center + (s * x + t * y) * *radius, *normal)
+            }
+            Emitter::Triangles {
+                triangles,
+                cumulative_area,
+            } => {
+                let total = *cumulative_area.last()?;
+                let target = u[0] * total;
+                let i = cumulative_area
+                    .partition_point(|&a| a <= target)
+                    .min(triangles.len() - 1);
+                let below = if i == 0 { 0.0 } else { cumulative_area[i - 1] };
+                let width = cumulative_area[i] - below;
+                // Reuse what is left of u[0] inside the chosen triangle's share.
+                let u0 = ((target - below) / width).clamp(0.0, 1.0 - f64::EPSILON);
+                let [a, b, c] = triangles[i];
+                let (b0, b1) = uniform_triangle([u0, u[1]]);
+                let n = (b - a).cross(c - a).normalized();
+                (a * b0 + b * b1 + c * (1.0 - b0 - b1), n)
+            }
+        };
+        let to = point - p;
+        let d2 = to.length_squared();
+        let cos_light = normal.dot(to).abs() / d2.sqrt();
+        if cos_light <= 0.0 || d2 == 0.0 {
+            return None;
+        }
+        Some((point, d2 / (cos_light * self.area())))
+    }
 }
 
 /// Light arriving at a point.
@@ -65,14 +202,57 @@ pub struct Incident {
     pub distance: f64,
     /// The light's point on the ray's far end, for aiming shadow rays; None at infinity.
     pub position: Option<Vec3>,
-    /// f(d)·I_L, with the spot's cone falloff applied.
+    /// f(d)·I_L, with the spot's cone falloff applied; for an area light, the sample's
+    /// estimate L_e / pdf (solid-angle pdf), so that averaging over samples gives ∫ L_e dω
+    /// weighted by whatever the shading multiplies it by.
     pub intensity: Color,
+    /// Where shadow rays stop, as a fraction of the way to `position`: just short of a
+    /// point light; a little further short of a sampled surface, whose own intersection
+    /// carries the rounding of its (single-precision) mesh.
+    pub shadow_end: f64,
 }
 
+/// Shadow rays to a point light stop just short of it.
+const POINT_SHADOW_END: f64 = 1.0 - 1e-9;
+/// Shadow rays to an area light stop this far short of the sampled point.
+const AREA_SHADOW_END: f64 = 1.0 - 1e-4;
+
 impl Light {
-    /// What the light sends to point `p`, before any shadowing; `None` when nothing arrives.
-    pub fn incident(&self, p: Vec3) -> Option<Incident> {
+    pub fn is_area(&self) -> bool {
+        matches!(self, Light::Area { .. })
+    }
+
+    /// Shadow rays per shading point: a square number, 1 for lights that are points.
+    pub fn samples(&self) -> u32 {
         match *self {
+            Light::Area { samples, .. } => {
+                let n = (samples.max(1) as f64).sqrt().ceil() as u32;
+                n * n
+            }
+            _ => 1,
+        }
+    }
+
+    /// What the light sends to point `p` along its sample `u` ∈ [0, 1)² (ignored by lights
+    /// that are points), before any shadowing; `None` when nothing arrives.
+    pub fn incident(&self, p: Vec3, u: [f64; 2]) -> Option<Incident> {
+        match *self {
+            Light::Area {
+                ref shape,
+                radiance,
+                ..
+            } => {
+                let (point, pdf) = shape.sample(p, u)?;
+                let to = point - p;
+                let d = to.length();
+                (pdf > 0.0 && pdf.is_finite() && d > 0.0).then(|| Incident {
+                    wi: to / d,
+                    distance: d,
+                    position: Some(point),
+                    intensity: radiance / pdf,
+                    shadow_end: AREA_SHADOW_END,
+                })
+            }
             Light::Point {
                 position,
                 intensity,
@@ -85,6 +265,7 @@ impl Light {
                     distance: d,
                     position: Some(position),
                     intensity: intensity * attenuation.factor(d),
+                    shadow_end: POINT_SHADOW_END,
                 })
             }
             Light::Directional {
@@ -95,6 +276,7 @@ impl Light {
                 distance: f64::INFINITY,
                 position: None,
                 intensity,
+                shadow_end: f64::INFINITY,
             }),
             Light::Spot {
                 position,
@@ -117,6 +299,7 @@ impl Light {
                     distance: d,
                     position: Some(position),
                     intensity: intensity * (attenuation.factor(d) * cone),
+                    shadow_end: POINT_SHADOW_END,
                 })
             }
         }
@@ -147,7 +330,7 @@ mod tests {
                 quadratic: 1.0,
             },
         };
-        let at = |d: f64| light.incident(Vec3::new(d, 0.0, 0.0)).unwrap().intensity.r;
+        let at = |d: f64| light.incident(Vec3::new(d, 0.0, 0.0), [0.5; 2]).unwrap().intensity.r;
         assert!((at(2.0) / at(4.0) - 4.0).abs() < 1e-12);
         assert!((at(3.0) - 1.0 / 9.0).abs() < 1e-15);
         // min(1, ·) keeps it finite up close.
@@ -167,7 +350,7 @@ mod tests {
         let at = |deg: f64| {
             let th = deg.to_radians();
             light
-                .incident(Vec3::new(th.sin(), -th.cos(), 0.0) * 5.0)
+                .incident(Vec3::new(th.sin(), -th.cos(), 0.0) * 5.0, [0.5; 2])
                 .map_or(0.0, |i| i.intensity.r)
         };
         assert_eq!(at(10.0), 1.0);

@@ -23,6 +23,10 @@ pub struct Material {
     pub ior: f64,
     /// Scale k_r and k_t by the dielectric Fresnel reflectance F and 1 − F.
     pub fresnel: bool,
+    /// Glossy reflection and refraction: reflected and refracted rays spread around the
+    /// mirror and Snell directions in a Phong lobe cos^n α of this exponent n (the smaller,
+    /// the blurrier); `None`: perfectly sharp.
+    pub gloss: Option<f64>,
 }
 
 impl Default for Material {
@@ -38,6 +42,7 @@ impl Default for Material {
             transmissive: Texture::Constant(Color::BLACK),
             ior: 1.0,
             fresnel: false,
+            gloss: None,
         }
     }
 }
@@ -54,6 +59,7 @@ pub struct Coefficients {
     pub transmissive: Color,
     pub ior: f64,
     pub fresnel: bool,
+    pub gloss: Option<f64>,
 }
 
 impl Coefficients {
@@ -76,11 +82,28 @@ impl Coefficients {
             transmissive: sum(|c| c.transmissive),
             ior: mean(|c| c.ior),
             fresnel: parts.iter().any(|(_, c)| c.fresnel),
+            // Exponents do not average meaningfully; the blurriest part wins.
+            gloss: parts
+                .iter()
+                .filter_map(|(_, c)| c.gloss)
+                .min_by(f64::total_cmp),
         }
     }
 }
 
 impl Material {
+    /// The material of an area light's surface: it shows its radiance and reflects nothing.
+    pub fn emitter(radiance: Color) -> Material {
+        let black = Texture::Constant(Color::BLACK);
+        Material {
+            emissive: Texture::Constant(radiance),
+            ambient: black.clone(),
+            diffuse: black.clone(),
+            specular: black,
+            ..Material::default()
+        }
+    }
+
     pub fn evaluate(&self, at: &TextureCoords) -> Coefficients {
         Coefficients {
             emissive: self.emissive.evaluate(at),
@@ -92,6 +115,7 @@ impl Material {
             transmissive: self.transmissive.evaluate(at),
             ior: self.ior,
             fresnel: self.fresnel,
+            gloss: self.gloss,
         }
     }
 

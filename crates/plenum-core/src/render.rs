@@ -1,5 +1,10 @@
 //! Rendering an image: tiles in parallel with rayon, samples per pixel from the sampler,
-//! radiance from the integrator.
+//! radiance from the integrator, weighted by the reconstruction filter.
+//!
+//! A pixel is Σ w_i·L_i / Σ w_i over its own samples, their offsets drawn from the filter
+//! itself (filter importance sampling; see [`crate::sampling::Filter`]). Adaptive sampling
+//! decides per pixel how many samples that takes: by Whitted's subdivision of the pixel
+//! where its corners differ, or by sampling until the estimated error is small enough.
 //!
 //! **Invariant:** the image depends only on the scene, the settings and the seed. Every pixel
 //! is computed from its own samples whose random streams come from (seed, pixel, sample), and
@@ -9,17 +14,21 @@ use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::Film;
 use crate::integrator::{RayCounts, RayTree, Whitted, WhittedConfig};
-use crate::sampling::{PixelSampler, Rng};
+use crate::sampling::{Filter, PixelSampler, Rng, SampleStream};
 use crate::scene::Scene;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     pub width: u32,
     pub height: u32,
     pub sampler: PixelSampler,
+    /// How samples are weighted into pixels.
+    pub filter: Filter,
+    /// Spend samples where the image needs them; replaces the sampler's fixed count.
+    pub adaptive: Option<Adaptive>,
     pub integrator: WhittedConfig,
     pub seed: u64,
     /// The SPD test procedure (Haines 1987): one ray through every pixel corner, (W+1)×(H+1)
@@ -33,12 +42,35 @@ impl Default for RenderSettings {
             width: 640,
             height: 480,
             sampler: PixelSampler::Grid { n: 1 },
+            filter: Filter::default(),
+            adaptive: None,
             integrator: WhittedConfig::default(),
             seed: 0,
             corners: false,
         }
     }
 }
+
+/// Adaptive sampling.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Adaptive {
+    /// Whitted (1980): trace the pixel's four corners; where they differ by more than
+    /// `contrast` (Mitchell's (max − min)/(max + min) of luminance), split the square in four
+    /// and trace the new corners, down to `depth` levels (at most [`MAX_SUBDIVISION`]). The
+    /// pixel is the area-weighted mean of its smallest squares' corner means (a box filter).
+    Subdivide { contrast: f64, depth: u32 },
+    /// Sample the pixel in batches of `min_spp` (Sobol points) until the standard error of
+    /// its luminance falls below `threshold` × max(mean, 0.05) — relative error in lit
+    /// pixels, absolute in dark ones — or `max_spp` samples are spent.
+    Variance {
+        threshold: f64,
+        min_spp: u32,
+        max_spp: u32,
+    },
+}
+
+/// The deepest subdivision `Adaptive::Subdivide` may ask for: 16 × 16 squares per pixel.
+pub const MAX_SUBDIVISION: u32 = 4;
 
 /// Side of the square tiles the image is cut into.
 pub const TILE_SIZE: u32 = 16;
@@ -83,7 +115,9 @@ pub fn render(
         for y in y0..y1 {
             for x in x0..x1 {
                 let c = if settings.corners {
-                    whitted.camera_ray(&camera.ray(x as f64, y as f64), &mut tile_counts, None)
+                    let mut stream = corner_stream(settings.seed, x, y);
+                    let ray = camera.ray(x as f64, y as f64);
+                    whitted.camera_ray(&ray, &mut stream, &mut tile_counts, None)
                 } else {
                     render_pixel(&whitted, &camera, settings, x, y, &mut tile_counts, None)
                 };
@@ -142,21 +176,150 @@ fn render_pixel(
 ) -> Color {
     if settings.corners {
         let mut sum = Color::BLACK;
-        for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
-            let ray = camera.ray(x as f64 + dx, y as f64 + dy);
-            sum += whitted.camera_ray(&ray, counts, tree.as_deref_mut());
+        for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            let mut stream = corner_stream(settings.seed, x + dx, y + dy);
+            let ray = camera.ray((x + dx) as f64, (y + dy) as f64);
+            sum += whitted.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut());
         }
         return sum * 0.25;
     }
-    let spp = settings.sampler.samples_per_pixel();
-    let mut sum = Color::BLACK;
-    for index in 0..spp {
-        let mut rng = Rng::for_sample(settings.seed, x, y, index);
-        let (dx, dy) = settings.sampler.offset(index, &mut rng);
-        let ray = camera.ray(x as f64 + dx, y as f64 + dy);
-        sum += whitted.camera_ray(&ray, counts, tree.as_deref_mut());
+    let (sampler, batch, limit) = match settings.adaptive {
+        Some(Adaptive::Subdivide { contrast, depth }) => {
+            return subdivide_pixel(whitted, camera, settings, (x, y), contrast, depth, counts, tree)
+        }
+        Some(Adaptive::Variance {
+            min_spp, max_spp, ..
+        }) => (PixelSampler::Sobol { spp: max_spp }, min_spp.max(2), max_spp),
+        None => {
+            let n = settings.sampler.samples_per_pixel();
+            (settings.sampler, n, n)
+        }
+    };
+    let mut estimate = PixelEstimate::default();
+    let mut index = 0;
+    while index < limit {
+        for _ in 0..batch.min(limit - index) {
+            let mut stream = sampler.stream(settings.seed, x, y, index);
+            let f = settings.filter.sample(stream.pixel());
+            let lens = stream.next_2d();
+            let shutter = stream.next_1d();
+            let (px, py) = (x as f64 + 0.5 + f.dx, y as f64 + 0.5 + f.dy);
+            let ray = camera.sample_ray(px, py, lens, shutter);
+            let c = whitted.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut());
+            estimate.add(c, f.weight);
+            index += 1;
+        }
+        match settings.adaptive {
+            Some(Adaptive::Variance { threshold, .. }) if !estimate.converged(threshold) => {}
+            _ => break,
+        }
     }
-    sum / spp as f64
+    estimate.value()
+}
+
+/// A pixel's running filter-weighted sum, and its luminance statistics for adaptive
+/// sampling.
+#[derive(Default)]
+struct PixelEstimate {
+    weighted: Color,
+    weight: f64,
+    plain: Color,
+    count: u32,
+    luminance: f64,
+    luminance_squared: f64,
+}
+
+impl PixelEstimate {
+    fn add(&mut self, c: Color, weight: f64) {
+        self.weighted += c * weight;
+        self.weight += weight;
+        self.plain += c;
+        self.count += 1;
+        let y = c.luminance();
+        self.luminance += y;
+        self.luminance_squared += y * y;
+    }
+
+    /// Σ w·L / Σ w; should the weights of a filter with negative lobes cancel out (a few
+    /// samples, all unlucky), the plain mean instead of a division by nearly zero.
+    fn value(&self) -> Color {
+        if self.weight > 0.25 * self.count as f64 {
+            self.weighted / self.weight
+        } else {
+            self.plain / self.count.max(1) as f64
+        }
+    }
+
+    fn converged(&self, threshold: f64) -> bool {
+        let n = self.count as f64;
+        let mean = self.luminance / n;
+        let variance = ((self.luminance_squared - n * mean * mean) / (n - 1.0)).max(0.0);
+        (variance / n).sqrt() <= threshold * mean.max(0.05)
+    }
+}
+
+/// Whitted's adaptive subdivision of pixel (x, y); see [`Adaptive::Subdivide`].
+#[allow(clippy::too_many_arguments)]
+fn subdivide_pixel(
+    whitted: &Whitted,
+    camera: &Camera,
+    settings: &RenderSettings,
+    (x, y): (u32, u32),
+    contrast: f64,
+    depth: u32,
+    counts: &mut RayCounts,
+    mut tree: Option<&mut RayTree>,
+) -> Color {
+    const SIDE: usize = (1 << MAX_SUBDIVISION) + 1;
+    let depth = depth.min(MAX_SUBDIVISION);
+    let step = 1usize << MAX_SUBDIVISION;
+    // Corners on the finest lattice, traced once each when first needed.
+    let mut corners = [[None::<Color>; SIDE]; SIDE];
+    let mut corner = |i: usize, j: usize, counts: &mut RayCounts| -> Color {
+        *corners[j][i].get_or_insert_with(|| {
+            let (fx, fy) = (i as f64 / step as f64, j as f64 / step as f64);
+            let index = (j * SIDE + i) as u32;
+            let mut stream = SampleStream::random(Rng::for_sample(settings.seed, x, y, index));
+            let ray = camera.sample_ray(x as f64 + fx, y as f64 + fy, stream.next_2d(), stream.next_1d());
+            whitted.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut())
+        })
+    };
+    // Squares still to look at: lattice corner (i, j), side in lattice steps, level.
+    // Depth-first, so at most three waiting squares per level plus the current one.
+    let mut stack = [(0usize, 0usize, step, 0u32); 3 * MAX_SUBDIVISION as usize + 2];
+    let mut waiting = 1;
+    let mut sum = Color::BLACK;
+    while waiting > 0 {
+        waiting -= 1;
+        let (i, j, side, level) = stack[waiting];
+        let c = [
+            corner(i, j, counts),
+            corner(i + side, j, counts),
+            corner(i, j + side, counts),
+            corner(i + side, j + side, counts),
+        ];
+        let lum = c.map(|c| c.luminance());
+        let (lo, hi) = lum.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+        let differ = hi - lo > contrast * (hi + lo).max(1e-6);
+        if differ && level < depth {
+            let half = side / 2;
+            for (di, dj) in [(0, 0), (half, 0), (0, half), (half, half)] {
+                stack[waiting] = (i + di, j + dj, half, level + 1);
+                waiting += 1;
+            }
+        } else {
+            let area = (side * side) as f64 / (step * step) as f64;
+            sum += (c[0] + c[1] + c[2] + c[3]) * (0.25 * area);
+        }
+    }
+    sum
+}
+
+/// The random numbers of the ray through corner (x, y) of the SPD corner grid.
+fn corner_stream(seed: u64, x: u32, y: u32) -> SampleStream {
+    SampleStream::random(Rng::for_sample(seed, x, y, u32::MAX))
 }
 
 /// The ray tree of one pixel: every ray of every sample, and the pixel's colour.

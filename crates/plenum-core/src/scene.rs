@@ -4,10 +4,10 @@
 use crate::accel::{Accel, AccelKind, LeafSize};
 use crate::camera::CameraSettings;
 use crate::color::Color;
-use crate::geometry::{HitRecord, Shape, TriangleMesh};
-use crate::light::Light;
+use crate::geometry::{Disk, HitRecord, Polygon, Shape, Sphere, TriangleMesh};
+use crate::light::{Emitter, Light};
 use crate::material::{Coefficients, Material};
-use crate::math::{gamma, Bounds3, Ray, Transform, Vec3};
+use crate::math::{gamma, Bounds3, Motion, Ray, Transform, Vec3};
 use crate::texture::TextureCoords;
 use std::sync::Arc;
 
@@ -20,6 +20,9 @@ pub struct Primitive {
     pub shape: Shape,
     /// Object-to-world transform; `None` when the shape is already in world coordinates.
     pub to_world: Option<Box<Transform>>,
+    /// For an object that moves while the shutter is open: its transforms at times 0 and 1,
+    /// which replace `to_world` (the pose at time 0).
+    pub motion: Option<Box<Motion>>,
     pub material: MaterialId,
     /// For meshes: a material per vertex, blended across each triangle by its barycentric
     /// coordinates (the course `.ray` format's per-vertex materials). Replaces `material`.
@@ -42,8 +45,17 @@ pub struct Interaction {
 }
 
 impl Primitive {
+    /// Calls `f` with the object-to-world transform at `time` (`None`: identity).
+    #[inline]
+    fn placed<R>(&self, time: f64, f: impl FnOnce(Option<&Transform>) -> R) -> R {
+        match &self.motion {
+            None => f(self.to_world.as_deref()),
+            Some(m) => f(Some(&m.at(time))),
+        }
+    }
+
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
-        match &self.to_world {
+        self.placed(ray.time, |placement| match placement {
             None => self.shape.intersect(ray, t_max),
             Some(t) => {
                 let (local, dt) = t.ray_to_object(ray);
@@ -51,7 +63,7 @@ impl Primitive {
                 hit.t += dt;
                 Some(hit)
             }
-        }
+        })
     }
 
     /// The hit in world space; `want_uv` asks for texture coordinates.
@@ -62,7 +74,7 @@ impl Primitive {
         primitive: u32,
         want_uv: bool,
     ) -> Interaction {
-        match &self.to_world {
+        self.placed(ray.time, |placement| match placement {
             None => {
                 let g = self.shape.surface(ray, hit, want_uv);
                 Interaction {
@@ -113,12 +125,12 @@ impl Primitive {
                     hit: *hit,
                 }
             }
-        }
+        })
     }
 
     /// Some hit in (0, t_max), not necessarily the nearest (see [`Shape::intersect_any`]).
     pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
-        match &self.to_world {
+        self.placed(ray.time, |placement| match placement {
             None => self.shape.intersect_any(ray, t_max),
             Some(t) => {
                 let (local, dt) = t.ray_to_object(ray);
@@ -126,14 +138,16 @@ impl Primitive {
                 hit.t += dt;
                 Some(hit)
             }
-        }
+        })
     }
 
+    /// World bounds; for a moving object, of everywhere it goes while the shutter is open.
     pub fn world_bounds(&self) -> Option<Bounds3> {
         let b = self.shape.bounds()?;
-        Some(match &self.to_world {
-            None => b,
-            Some(t) => Bounds3::from_points(b.corners().map(|c| t.point(c))),
+        Some(match (&self.motion, &self.to_world) {
+            (Some(m), _) => m.bounds(&b),
+            (None, None) => b,
+            (None, Some(t)) => Bounds3::from_points(b.corners().map(|c| t.point(c))),
         })
     }
 }
@@ -148,6 +162,8 @@ pub struct Scene {
     pub material_names: Vec<String>,
     pub lights: Vec<Light>,
     pub light_names: Vec<String>,
+    /// Per light: the primitive that shows it, for area lights.
+    pub light_objects: Vec<Option<u32>>,
     /// Per primitive: some light can pass through (a transmissive material or vertex material).
     transmissive: Vec<bool>,
     /// Per primitive: its material looks something up by texture coordinates.
@@ -328,6 +344,7 @@ pub struct SceneBuilder {
     material_names: Vec<String>,
     lights: Vec<Light>,
     light_names: Vec<String>,
+    light_objects: Vec<Option<u32>>,
 }
 
 impl SceneBuilder {
@@ -348,6 +365,7 @@ impl SceneBuilder {
         self.primitives.push(Primitive {
             shape,
             to_world: (!to_world.is_identity()).then(|| Box::new(to_world)),
+            motion: None,
             material,
             vertex_materials: None,
         });
@@ -369,9 +387,105 @@ impl SceneBuilder {
         }
     }
 
+    /// Makes the last object added move from its transform at time 0 to `close` at time 1.
+    pub fn set_last_motion(&mut self, close: Transform) {
+        if let Some(p) = self.primitives.last_mut() {
+            let open = p.to_world.as_deref().copied().unwrap_or(Transform::IDENTITY);
+            if open != close {
+                p.motion = Some(Box::new(Motion::new(&open, &close)));
+            }
+        }
+    }
+
+    /// Adds an area light and the surface that shows it: a rectangle, disk or sphere that
+    /// emits `radiance` (seen by camera, reflected and refracted rays, casting shadows on
+    /// other lights' receivers), and `samples` shadow rays per shading point.
+    pub fn add_area_light(
+        &mut self,
+        name: impl Into<String>,
+        emitter: Emitter,
+        radiance: Color,
+        samples: u32,
+    ) {
+        let name = name.into();
+        let shape = match &emitter {
+            Emitter::Rectangle {
+                corner,
+                edge_u,
+                edge_v,
+            } => Polygon::new(vec![
+                *corner,
+                *corner + *edge_u,
+                *corner + *edge_u + *edge_v,
+                *corner + *edge_v,
+            ])
+            .ok()
+            .map(|p| Shape::Polygon(Box::new(p))),
+            Emitter::Disk {
+                center,
+                normal,
+                radius,
+            } => Some(Shape::Disk(Disk::new(*center, *normal, *radius))),
+            Emitter::Sphere { center, radius } => {
+                Some(Shape::Sphere(Sphere::new(*center, *radius)))
+            }
+            Emitter::Triangles { .. } => None,
+        };
+        let object = shape.map(|shape| {
+            let material = self.add_material(format!("{name} (emitter)"), Material::emitter(radiance));
+            self.add_object(name.clone(), shape, Transform::IDENTITY, material);
+            (self.primitives.len() - 1) as u32
+        });
+        self.add_light(
+            name,
+            Light::Area {
+                shape: emitter,
+                radiance,
+                samples,
+            },
+        );
+        if let Some(last) = self.light_objects.last_mut() {
+            *last = object;
+        }
+    }
+
+    /// Adds a triangle mesh that emits `radiance` from both sides of every triangle: an
+    /// object to see and an area light sampled over its triangles by area.
+    pub fn add_mesh_light(
+        &mut self,
+        name: impl Into<String>,
+        mesh: Arc<TriangleMesh>,
+        to_world: Transform,
+        radiance: Color,
+        samples: u32,
+    ) {
+        let name = name.into();
+        let triangles = mesh
+            .triangles()
+            .iter()
+            .map(|t| t.map(|i| to_world.point(mesh.positions()[i as usize])))
+            .collect();
+        let material = self.add_material(format!("{name} (emitter)"), Material::emitter(radiance));
+        self.add_object(name.clone(), Shape::Mesh(mesh), to_world, material);
+        if let Some(shape) = Emitter::triangles(triangles) {
+            self.add_light(
+                name,
+                Light::Area {
+                    shape,
+                    radiance,
+                    samples,
+                },
+            );
+            if let Some(last) = self.light_objects.last_mut() {
+                *last = Some((self.primitives.len() - 1) as u32);
+            }
+        }
+    }
+
     pub fn add_light(&mut self, name: impl Into<String>, light: Light) {
         self.lights.push(light);
         self.light_names.push(name.into());
+        self.light_objects.push(None);
     }
 
     /// Builds the scene with the default acceleration structure, a BVH.
@@ -430,6 +544,7 @@ impl SceneBuilder {
             material_names: self.material_names,
             lights: self.lights,
             light_names: self.light_names,
+            light_objects: self.light_objects,
             ambient: self.ambient,
             background: self.background,
         };

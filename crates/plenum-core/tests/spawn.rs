@@ -133,6 +133,7 @@ fn spawned_rays_never_rehit_their_surface() {
                 vertex_materials: None,
                 shape,
                 to_world,
+                motion: None,
                 material: 0,
             };
             let Some(bounds) = prim.world_bounds() else {

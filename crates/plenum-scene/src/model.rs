@@ -76,6 +76,7 @@ pub fn load_model(path: &Path, extension: &str) -> Result<LoadedScene, SceneErro
         look_at: center,
         up: Vec3::Y,
         fov_degrees: FOV,
+        ..CameraSettings::default()
     };
     builder.background = Color::new(0.18, 0.2, 0.24);
     builder.ambient = Color::gray(0.12);

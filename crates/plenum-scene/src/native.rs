@@ -3,13 +3,13 @@
 use crate::diagnostics::{did_you_mean, SceneError};
 use crate::reader::{Fields, Result, Source, Value};
 use crate::{obj, ply, RenderDefaults};
-use plenum_core::camera::CameraSettings;
+use plenum_core::camera::{CameraSettings, Lens};
 use plenum_core::color::Color;
 use plenum_core::geometry::{
     Cone, Cuboid, Cylinder, Disk, Plane, Polygon, Polyhedron, Shape, Sphere, TriangleMesh,
 };
 use plenum_core::integrator::MAX_DEPTH;
-use plenum_core::light::{Attenuation, Light};
+use plenum_core::light::{Attenuation, Emitter, Light};
 use plenum_core::material::Material;
 use plenum_core::math::{Matrix4, Transform, Vec3};
 use plenum_core::sampling::MAX_SPP;
@@ -29,7 +29,7 @@ const TOP_LEVEL: &[&str] = &[
     "lights",
     "objects",
 ];
-const COMMON: [&str; 4] = ["type", "name", "material", "transform"];
+const COMMON: [&str; 5] = ["type", "name", "material", "transform", "transform_close"];
 
 /// Parses a native scene. `base_dir` resolves relative paths (meshes, textures).
 /// Also returns warnings: statements of referenced mesh files that were read past.
@@ -151,7 +151,22 @@ impl<'s> Reader<'s> {
         let f = self.src.table(
             v,
             "[camera]",
-            &["position", "look_at", "up", "fov", "resolution"],
+            &[
+                "position",
+                "look_at",
+                "up",
+                "fov",
+                "resolution",
+                "aperture",
+                "f_number",
+                "focal_length",
+                "focus_distance",
+                "blades",
+                "blade_rotation",
+                "shutter",
+                "position_close",
+                "look_at_close",
+            ],
         )?;
         let c = CameraSettings::default();
         let position = f.vec3_or("position", c.position)?;
@@ -196,13 +211,91 @@ impl<'s> Reader<'s> {
             d.width = w as u32;
             d.height = h as u32;
         }
+        let lens = self.lens(&f, (look_at - position).length())?;
+        let shutter = match f.get("shutter") {
+            None => c.shutter,
+            Some(v) => {
+                let [open, close] = self.src.numbers::<2>(v, "[open, close] times")?;
+                if close < open {
+                    return Err(self.src.error(
+                        v.span(),
+                        format!("the shutter closes ({close}) before it opens ({open})"),
+                    ));
+                }
+                [open, close]
+            }
+        };
+        let motion = match (f.vec3("position_close")?, f.vec3("look_at_close")?) {
+            (None, None) => None,
+            (p, l) => {
+                let (p, l) = (p.unwrap_or(position), l.unwrap_or(look_at));
+                if (l - p).length_squared() == 0.0 || up.cross(l - p).length_squared() == 0.0 {
+                    let span = f
+                        .get("look_at_close")
+                        .or(f.get("position_close"))
+                        .map_or(f.span.clone(), |v| v.span());
+                    return Err(self.src.error(
+                        span,
+                        "at shutter close the camera looks at its own position or along `up`",
+                    ));
+                }
+                Some((p, l))
+            }
+        };
         self.builder.camera = CameraSettings {
             position,
             look_at,
             up,
             fov_degrees: fov,
+            lens,
+            shutter,
+            motion,
         };
         Ok(())
+    }
+
+    /// The thin lens: an aperture radius, or an f-number with a focal length (radius =
+    /// focal length / 2N); focused at `focus_distance`, by default on `look_at`.
+    fn lens(&self, f: &Fields<'_, 's>, look_distance: f64) -> Result<Lens> {
+        let radius = match (f.get("aperture"), f.get("f_number")) {
+            (Some(a), Some(_)) => {
+                return Err(self
+                    .src
+                    .error(a.span(), "give either `aperture` or `f_number`, not both"))
+            }
+            (Some(_), None) => f.non_negative_or("aperture", 0.0)?,
+            (None, Some(_)) => {
+                let n = f.positive("f_number", None)?;
+                let Some(_) = f.get("focal_length") else {
+                    return Err(self.src.error(
+                        f.required("f_number")?.span(),
+                        "an f-number needs a `focal_length` (in scene units) to give an aperture",
+                    ));
+                };
+                f.positive("focal_length", None)? / (2.0 * n)
+            }
+            (None, None) => {
+                if let Some(v) = f.get("focal_length") {
+                    return Err(self
+                        .src
+                        .error(v.span(), "`focal_length` is only used with `f_number`"));
+                }
+                0.0
+            }
+        };
+        let blades = f.count("blades")?.unwrap_or(0);
+        if blades == 1 || blades == 2 || blades > 64 {
+            return Err(self.src.error(
+                f.required("blades")?.span(),
+                format!("expected 0 (a round aperture) or 3 to 64 blades, found {blades}"),
+            ));
+        }
+        Ok(Lens {
+            radius,
+            focus_distance: f.positive("focus_distance", Some(look_distance))?,
+            blades,
+            rotation_degrees: f.number_or("blade_rotation", 0.0)?,
+        })
     }
 
     /// A colour: `[r, g, b]`, a grey level, or a texture table.
@@ -305,6 +398,7 @@ impl<'s> Reader<'s> {
             "transmissive",
             "ior",
             "fresnel",
+            "gloss",
         ];
         let f = self.src.table(v, &format!("material `{name}`"), FIELDS)?;
         let d = Material::default();
@@ -335,6 +429,10 @@ impl<'s> Reader<'s> {
             transmissive: tex("transmissive", d.transmissive.clone())?,
             ior: f.positive("ior", Some(1.0))?,
             fresnel,
+            gloss: match f.get("gloss") {
+                None => None,
+                Some(_) => Some(f.positive("gloss", None)?),
+            },
         };
         let id = self.builder.add_material(name, m);
         self.materials.insert(name.to_string(), id);
@@ -342,7 +440,19 @@ impl<'s> Reader<'s> {
     }
 
     fn light(&mut self, index: usize, v: &Value<'s>) -> Result<()> {
-        let kind = self.kind(v, "a light", &["point", "directional", "spot", "ambient"])?;
+        let kind = self.kind(
+            v,
+            "a light",
+            &[
+                "point",
+                "directional",
+                "spot",
+                "ambient",
+                "rectangle",
+                "disk",
+                "sphere",
+            ],
+        )?;
         let what = format!("{kind} light");
         let name_of = |f: &Fields| -> Result<String> {
             Ok(f.string("name")?
@@ -420,6 +530,48 @@ impl<'s> Reader<'s> {
                 };
                 self.builder.add_light(name_of(&f)?, light);
             }
+            "rectangle" | "disk" | "sphere" => {
+                let shape_keys: &[&str] = match kind.as_str() {
+                    "rectangle" => &["corner", "edge_u", "edge_v"],
+                    "disk" => &["center", "normal", "radius"],
+                    _ => &["center", "radius"],
+                };
+                let keys: Vec<&str> = ["type", "name", "color", "intensity", "samples"]
+                    .into_iter()
+                    .chain(shape_keys.iter().copied())
+                    .collect();
+                let f = self.src.table(v, &what, &keys)?;
+                let emitter = match kind.as_str() {
+                    "rectangle" => {
+                        let (edge_u, edge_v) =
+                            (f.required_vec3("edge_u")?, f.required_vec3("edge_v")?);
+                        if edge_u.cross(edge_v).length_squared() == 0.0 {
+                            return Err(self.src.error(
+                                f.required("edge_v")?.span(),
+                                "the rectangle's edges are parallel: it has no area",
+                            ));
+                        }
+                        Emitter::Rectangle {
+                            corner: f.required_vec3("corner")?,
+                            edge_u,
+                            edge_v,
+                        }
+                    }
+                    "disk" => Emitter::Disk {
+                        center: f.required_vec3("center")?,
+                        normal: f.direction("normal", None)?.normalized(),
+                        radius: f.positive("radius", None)?,
+                    },
+                    _ => Emitter::Sphere {
+                        center: f.required_vec3("center")?,
+                        radius: f.positive("radius", None)?,
+                    },
+                };
+                let samples = self.light_samples(&f, "samples")?;
+                let radiance = intensity(&f)?;
+                self.builder
+                    .add_area_light(name_of(&f)?, emitter, radiance, samples);
+            }
             _ => {
                 let f = self
                     .src
@@ -428,6 +580,19 @@ impl<'s> Reader<'s> {
             }
         }
         Ok(())
+    }
+
+    /// Shadow rays per shading point for an area light: 1 to 1024, 1 by default (more
+    /// pixel samples smooth the penumbra just as well).
+    fn light_samples(&self, f: &Fields<'_, 's>, key: &str) -> Result<u32> {
+        let n = f.count(key)?.unwrap_or(1);
+        if n == 0 || n > 1024 {
+            return Err(self.src.error(
+                f.required(key)?.span(),
+                format!("expected between 1 and 1024 shadow rays per point, found {n}"),
+            ));
+        }
+        Ok(n)
     }
 
     fn attenuation(&self, f: &Fields<'_, 's>) -> Result<Attenuation> {
@@ -517,6 +682,8 @@ impl<'s> Reader<'s> {
                 "normals",
                 "uvs",
                 "vertex_materials",
+                "emission",
+                "light_samples",
             ],
         };
         let allowed: Vec<&'static str> = COMMON.iter().chain(fields).copied().collect();
@@ -531,6 +698,28 @@ impl<'s> Reader<'s> {
             .string("name")?
             .map_or_else(|| format!("{kind} {}", index + 1), str::to_string);
         let to_world = placement.after(&frame);
+        let close = match f.get("transform_close") {
+            Some(t) => Some(self.transform(t)?.after(&frame)),
+            None => None,
+        };
+        if let (Some(e), Shape::Mesh(mesh)) = (f.get("emission"), &shape) {
+            if f.get("material").is_some() || f.get("vertex_materials").is_some() {
+                return Err(self.src.error(
+                    e.span(),
+                    "an emitting mesh shows its emission: drop `material` or `vertex_materials`",
+                ));
+            }
+            if close.is_some() {
+                return Err(self
+                    .src
+                    .error(e.span(), "an emitting mesh cannot move (`transform_close`)"));
+            }
+            let radiance = self.non_negative(e, self.color(e)?)?;
+            let samples = self.light_samples(&f, "light_samples")?;
+            self.builder
+                .add_mesh_light(name, mesh.clone(), to_world, radiance, samples);
+            return Ok(());
+        }
         match (f.get("vertex_materials"), shape) {
             (Some(list), Shape::Mesh(mesh)) => {
                 let items = self
@@ -554,6 +743,9 @@ impl<'s> Reader<'s> {
                     .add_mesh_with_vertex_materials(name, mesh, to_world, ids);
             }
             (_, shape) => self.builder.add_object(name, shape, to_world, material),
+        }
+        if let Some(close) = close {
+            self.builder.set_last_motion(close);
         }
         Ok(())
     }

@@ -90,6 +90,7 @@ pub fn parse(path: &Path, text: &str) -> Result<(SceneBuilder, RenderDefaults), 
                     transmissive: Texture::Constant(Color::gray(t)),
                     ior: if ior > 0.0 { ior } else { 1.0 },
                     fresnel: false,
+                    gloss: None,
                 };
                 let id = builder.add_material(format!("f{}", counts[3] + 1), m);
                 counts[3] += 1;
@@ -374,6 +375,7 @@ impl<'s, I: Iterator<Item = (&'s str, Range<usize>)>> Parser<'s, I> {
             look_at: at,
             up,
             fov_degrees: 2.0 * half.atan().to_degrees(),
+            ..CameraSettings::default()
         };
         Ok((camera, angle, w as u32, h_px))
     }

@@ -76,6 +76,7 @@ pub fn parse(
         look_at: -Vec3::Z,
         up: Vec3::Y,
         fov_degrees: 2.0 * 0.5f64.atan().to_degrees(),
+        ..CameraSettings::default()
     };
     p.header()?;
     while p.pos < p.tokens.len() {
@@ -103,6 +104,7 @@ fn zero_material() -> Material {
         transmissive: black(),
         ior: 1.0,
         fresnel: false,
+                    gloss: None,
     }
 }
 

@@ -6,7 +6,7 @@
 use crate::RenderDefaults;
 use plenum_core::color::Color;
 use plenum_core::geometry::Shape;
-use plenum_core::light::{Attenuation, Light};
+use plenum_core::light::{Attenuation, Emitter, Light};
 use plenum_core::math::{Transform, Vec3};
 use plenum_core::scene::Scene;
 use plenum_core::texture::Texture;
@@ -28,7 +28,7 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
     let c = &scene.camera;
     let _ = writeln!(
         w,
-        "[camera]\nposition = {}\nlook_at = {}\nup = {}\nfov = {:?}\nresolution = [{}, {}]\n",
+        "[camera]\nposition = {}\nlook_at = {}\nup = {}\nfov = {:?}\nresolution = [{}, {}]",
         vec(c.position),
         vec(c.look_at),
         vec(c.up),
@@ -36,6 +36,29 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
         defaults.width,
         defaults.height
     );
+    let _ = writeln!(
+        w,
+        "shutter = [{:?}, {:?}]",
+        c.shutter[0], c.shutter[1]
+    );
+    if c.lens.radius > 0.0 {
+        let _ = writeln!(
+            w,
+            "aperture = {:?}\nfocus_distance = {:?}\nblades = {}\nblade_rotation = {:?}",
+            c.lens.radius, c.lens.focus_distance, c.lens.blades, c.lens.rotation_degrees
+        );
+    }
+    if let Some((p, l)) = c.motion {
+        let _ = writeln!(w, "position_close = {}\nlook_at_close = {}", vec(p), vec(l));
+    }
+    let _ = writeln!(w);
+    // Objects that show an area light are written with their light.
+    let mut shows_light: HashMap<u32, usize> = HashMap::new();
+    for (i, o) in scene.light_objects.iter().enumerate() {
+        if let Some(o) = o {
+            shows_light.insert(*o, i);
+        }
+    }
     let keys = unique_keys(&scene.material_names, "material");
     for (key, m) in keys.iter().zip(&scene.materials) {
         let _ = writeln!(w, "[materials.{}]", quote(key));
@@ -51,9 +74,13 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
         }
         let _ = writeln!(
             w,
-            "shininess = {:?}\nior = {:?}\nfresnel = {}\n",
+            "shininess = {:?}\nior = {:?}\nfresnel = {}",
             m.shininess, m.ior, m.fresnel
         );
+        if let Some(g) = m.gloss {
+            let _ = writeln!(w, "gloss = {g:?}");
+        }
+        let _ = writeln!(w);
     }
     // Meshes used more than once are written once.
     let mut uses: HashMap<*const (), usize> = HashMap::new();
@@ -83,8 +110,58 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
         );
     }
     for (light, name) in scene.lights.iter().zip(&scene.light_names) {
+        if let Light::Area {
+            shape: Emitter::Triangles { .. },
+            ..
+        } = light
+        {
+            // Written as its mesh object, with `emission`.
+            continue;
+        }
         let _ = writeln!(w, "[[lights]]\nname = {}", quote(name));
         match light {
+            Light::Area {
+                shape,
+                radiance,
+                samples,
+            } => {
+                let _ = match shape {
+                    Emitter::Rectangle {
+                        corner,
+                        edge_u,
+                        edge_v,
+                    } => writeln!(
+                        w,
+                        "type = \"rectangle\"\ncorner = {}\nedge_u = {}\nedge_v = {}",
+                        vec(*corner),
+                        vec(*edge_u),
+                        vec(*edge_v)
+                    ),
+                    Emitter::Disk {
+                        center,
+                        normal,
+                        radius,
+                    } => writeln!(
+                        w,
+                        "type = \"disk\"\ncenter = {}\nnormal = {}\nradius = {:?}",
+                        vec(*center),
+                        vec(*normal),
+                        radius
+                    ),
+                    Emitter::Sphere { center, radius } => writeln!(
+                        w,
+                        "type = \"sphere\"\ncenter = {}\nradius = {:?}",
+                        vec(*center),
+                        radius
+                    ),
+                    Emitter::Triangles { .. } => Ok(()),
+                };
+                let _ = writeln!(
+                    w,
+                    "color = {}\nsamples = {samples}\n",
+                    color(*radiance)
+                );
+            }
             Light::Point {
                 position,
                 intensity,
@@ -130,13 +207,27 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
             }
         }
     }
-    for (p, name) in scene.primitives.iter().zip(&scene.object_names) {
-        let _ = writeln!(
-            w,
-            "[[objects]]\nname = {}\nmaterial = {}",
-            quote(name),
-            quote(&keys[p.material as usize])
-        );
+    for (index, (p, name)) in scene.primitives.iter().zip(&scene.object_names).enumerate() {
+        let light = shows_light.get(&(index as u32)).map(|&i| &scene.lights[i]);
+        let _ = match light {
+            Some(Light::Area {
+                shape: Emitter::Triangles { .. },
+                radiance,
+                samples,
+            }) => writeln!(
+                w,
+                "[[objects]]\nname = {}\nemission = {}\nlight_samples = {samples}",
+                quote(name),
+                color(*radiance)
+            ),
+            Some(_) => continue,
+            None => writeln!(
+                w,
+                "[[objects]]\nname = {}\nmaterial = {}",
+                quote(name),
+                quote(&keys[p.material as usize])
+            ),
+        };
         let _ = match &p.shape {
             Shape::Sphere(s) => writeln!(w, "type = \"sphere\"\ncenter = {}\nradius = {:?}\ninside_only = {}", vec(s.center), s.radius, s.inside_only),
             Shape::Plane(s) => writeln!(w, "type = \"plane\"\npoint = {}\nnormal = {}", vec(s.point), vec(s.normal)),
@@ -180,6 +271,9 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
         }
         if let Some(t) = &p.to_world {
             let _ = writeln!(w, "transform = [{{ matrix = {} }}]", matrix(t));
+        }
+        if let Some(m) = &p.motion {
+            let _ = writeln!(w, "transform_close = [{{ matrix = {} }}]", matrix(&m.at(1.0)));
         }
         let _ = writeln!(w);
     }

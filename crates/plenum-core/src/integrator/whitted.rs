@@ -7,12 +7,20 @@
 //! the occluders' k_t when they are transmissive, 0 behind an opaque one. Recursion stops at
 //! the maximum depth and when a ray's weight in the pixel drops below a threshold (Hall and
 //! Greenberg 1983). On total internal reflection the refracted weight goes to reflection.
+//!
+//! It becomes distribution ray tracing (Cook, Porter and Carpenter 1984) where the scene asks
+//! for it: an area light's S_L·I_L is averaged over shadow rays to points stratified over its
+//! area, and a glossy material's reflected and refracted rays are drawn from a Phong lobe
+//! around the mirror and Snell directions (the lobe is normalised, so the weight stays k_r or
+//! k_t; a direction drawn below the surface carries nothing). Their random numbers come from
+//! the pixel sample's stream, so the sampler stratifies them across the pixel's samples.
 
 use super::{MediumStack, RayKind, RayNode, RayTree, ShadowInfo, Stop};
 use crate::color::Color;
 use crate::light::Incident;
 use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::optics::{fresnel_dielectric, reflect, refract};
+use crate::sampling::{phong_lobe, Frame, SampleStream};
 use crate::scene::{Interaction, Scene};
 
 /// The deepest recursion allowed: each bounce is a stack frame, and past a few hundred
@@ -59,9 +67,6 @@ impl RayCounts {
     }
 }
 
-/// Shadow rays to a point light stop just short of it.
-const SHADOW_END: f64 = 1.0 - 1e-9;
-
 pub struct Whitted<'a> {
     scene: &'a Scene,
     config: WhittedConfig,
@@ -82,10 +87,12 @@ impl<'a> Whitted<'a> {
         Whitted { scene, config }
     }
 
-    /// Radiance along a camera ray. With `tree`, every ray traced is recorded in it.
+    /// Radiance along a camera ray; `stream` gives the random numbers of its pixel sample.
+    /// With `tree`, every ray traced is recorded in it.
     pub fn camera_ray(
         &self,
         ray: &Ray,
+        stream: &mut SampleStream,
         counts: &mut RayCounts,
         tree: Option<&mut RayTree>,
     ) -> Color {
@@ -98,10 +105,16 @@ impl<'a> Whitted<'a> {
             tree,
             parent: None,
         };
-        self.trace(ray, branch, counts)
+        self.trace(ray, branch, stream, counts)
     }
 
-    fn trace(&self, ray: &Ray, mut b: Branch, counts: &mut RayCounts) -> Color {
+    fn trace(
+        &self,
+        ray: &Ray,
+        mut b: Branch,
+        stream: &mut SampleStream,
+        counts: &mut RayCounts,
+    ) -> Color {
         let node = b.tree.as_deref_mut().map(|t| {
             t.push(RayNode::new(
                 b.parent,
@@ -139,23 +152,41 @@ impl<'a> Whitted<'a> {
         // Local illumination: emission, ambient, and Phong from every light.
         let mut color = k.emissive + k.ambient * self.scene.ambient;
         for (li, light) in self.scene.lights.iter().enumerate() {
-            let Some(inc) = light.incident(it.p) else {
-                continue;
+            // An area light's m × m shadow rays share one offset from the stream, each in
+            // its own cell: stratified within the shading point, and the offset stratified
+            // across the pixel's samples.
+            let count = light.samples();
+            let offset = if light.is_area() {
+                stream.next_2d()
+            } else {
+                [0.5; 2]
             };
-            let cos = ns.dot(inc.wi);
-            if cos <= 0.0 || n.dot(inc.wi) <= 0.0 {
-                continue;
+            let m = (count as f64).sqrt().round() as u32;
+            let mut sum = Color::BLACK;
+            for cell in 0..count {
+                let u = [
+                    ((cell % m) as f64 + offset[0]) / m as f64,
+                    ((cell / m) as f64 + offset[1]) / m as f64,
+                ];
+                let Some(inc) = light.incident(it.p, u) else {
+                    continue;
+                };
+                let cos = ns.dot(inc.wi);
+                if cos <= 0.0 || n.dot(inc.wi) <= 0.0 {
+                    continue;
+                }
+                let s = self.shadow(ray, &it, n, &inc, li, &mut b, node, counts);
+                if s.is_black() {
+                    continue;
+                }
+                let mut response = k.diffuse * cos;
+                if !k.specular.is_black() {
+                    let r = reflect(-inc.wi, ns);
+                    response += k.specular * r.dot(v).max(0.0).powf(k.shininess);
+                }
+                sum += s * inc.intensity * response;
             }
-            let s = self.shadow(&it, n, &inc, li, &mut b, node, counts);
-            if s.is_black() {
-                continue;
-            }
-            let mut response = k.diffuse * cos;
-            if !k.specular.is_black() {
-                let r = reflect(-inc.wi, ns);
-                response += k.specular * r.dot(v).max(0.0).powf(k.shininess);
-            }
-            color += s * inc.intensity * response;
+            color += sum / count as f64;
         }
 
         // Global illumination: the reflected and refracted rays.
@@ -217,9 +248,18 @@ impl<'a> Whitted<'a> {
             (RayKind::Refracted, kt, refracted, &media_t),
         ];
         for (kind, coefficient, direction, media) in secondary {
-            let Some(direction) = direction.filter(|_| !coefficient.is_black()) else {
+            let Some(mut direction) = direction.filter(|_| !coefficient.is_black()) else {
                 continue;
             };
+            if let Some(exponent) = k.gloss {
+                let lobe = Frame::from_z(direction).to_world(phong_lobe(stream.next_2d(), exponent));
+                // Reflected rays stay above the surface, refracted ones go below.
+                let above = lobe.dot(n) > 0.0;
+                if above != (kind == RayKind::Reflected) {
+                    continue;
+                }
+                direction = lobe;
+            }
             if b.depth >= self.config.max_depth {
                 record(&mut b, node, |n| n.stops.push(Stop::Depth));
                 continue;
@@ -242,7 +282,8 @@ impl<'a> Whitted<'a> {
                 tree: b.tree.as_deref_mut(),
                 parent: node,
             };
-            color += coefficient * self.trace(&Ray::new(origin, direction), child, counts);
+            let next = Ray::new(origin, direction).at_time(ray.time);
+            color += coefficient * self.trace(&next, child, stream, counts);
         }
         record(&mut b, node, |n| n.color = color);
         color
@@ -255,6 +296,7 @@ impl<'a> Whitted<'a> {
     #[allow(clippy::too_many_arguments)]
     fn shadow(
         &self,
+        from: &Ray,
         it: &Interaction,
         n: Vec3,
         inc: &Incident,
@@ -268,12 +310,9 @@ impl<'a> Whitted<'a> {
         let ray = match inc.position {
             Some(light_at) => Ray::new(origin, light_at - origin),
             None => Ray::new(origin, inc.wi),
-        };
-        let t_max = if inc.position.is_some() {
-            SHADOW_END
-        } else {
-            f64::INFINITY
-        };
+        }
+        .at_time(from.time);
+        let t_max = inc.shadow_end;
         let recording = b.tree.is_some();
         let mut occluders: Vec<(f64, u32)> = Vec::new();
         let mut s = Color::WHITE;

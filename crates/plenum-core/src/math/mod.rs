@@ -2,11 +2,13 @@
 
 mod bounds;
 pub mod float;
+mod motion;
 mod ray;
 mod transform;
 mod vector;
 
 pub use bounds::Bounds3;
+pub use motion::Motion;
 pub use float::{gamma, offset_ray_origin, solve_quadratic};
 pub use ray::Ray;
 pub use transform::{Matrix4, Transform};

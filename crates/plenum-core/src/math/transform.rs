@@ -276,7 +276,7 @@ impl Transform {
         } else {
             0.0
         };
-        (Ray::new(o + d * dt, d), dt)
+        (Ray::new(o + d * dt, d).at_time(ray.time), dt)
     }
 }
 

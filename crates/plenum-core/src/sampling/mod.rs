@@ -3,8 +3,14 @@
 //! **Invariant:** a sample's random numbers derive from (seed, pixel, sample index) alone,
 //! never from the thread that computes it, so images do not depend on the thread count.
 
+#[cfg(test)]
+pub(crate) mod chi_square;
+mod filter;
 mod pixel;
 mod rng;
+mod warp;
 
-pub use pixel::{PixelSampler, SamplerKind, MAX_SPP};
+pub use filter::{Filter, FilterKind};
+pub use pixel::{permute, PixelSampler, SampleStream, SamplerKind, MAX_SPP};
 pub use rng::Rng;
+pub use warp::*;

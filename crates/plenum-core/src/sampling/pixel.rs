@@ -1,30 +1,73 @@
-//! Where in a pixel each sample goes: a regular grid, independent uniform points, or one
-//! uniform point in each cell of a grid (jittered, or stratified, sampling). The renderer
-//! asks only for the count and the positions; every random number comes from the sample's
-//! own generator (seed, pixel, sample index).
+//! The random numbers of a pixel's samples: where in the pixel each sample goes, and the
+//! values it uses for the lens, the shutter time, the lights' areas and glossy directions.
+//!
+//! A pixel sample is a stream of values, one "dimension" after another: the pixel position
+//! first, then the lens, the time, and whatever the integrator asks for along the way. How
+//! the values of one dimension spread over the pixel's samples is the sampler's business:
+//!
+//! - `grid`: the pixel position on a regular √N×√N grid; the other dimensions stratified as
+//!   for `jittered`.
+//! - `random`: every value independent and uniform.
+//! - `jittered`: each 2-D dimension split into √N×√N cells and each 1-D one into N strata;
+//!   sample i takes one cell, jittered inside it. The pixel's cells go in order; the other
+//!   dimensions' cells are shuffled per pixel and dimension, so the lens cell of a sample does
+//!   not follow from its pixel cell.
+//! - `cook16`: Cook's correlated scheme (Cook 1986): the pixel and every direction domain split
+//!   into 16 regions; sub-pixel m pairs with region m of every domain through one fixed table
+//!   per dimension (the same for every pixel), each sample jittered inside its region. More
+//!   than 16 samples repeat the pattern with fresh jitter.
+//! - `sobol`: Owen-scrambled Sobol points (Burley 2020); each dimension takes a 2-D (or 1-D)
+//!   Sobol set under its own scramble seed, so every pair is well stratified ("padding").
+//!
+//! **Invariant:** a value depends on (seed, pixel, sample index, dimension) only.
 
 use super::Rng;
 
-/// The most samples per pixel a render may ask for (a 256 × 256 grid).
+/// The most samples per pixel a render may ask for (a 256 × 256 grid; the Sobol sequence's
+/// length).
 pub const MAX_SPP: u32 = 1 << 16;
+
+/// Dimensions past this many take plain random values: deep bounces gain little from
+/// stratification.
+const STRATIFIED_DIMENSIONS: u32 = 64;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PixelSampler {
-    /// Regular supersampling on an n × n grid of sub-pixel centres, averaged (a box filter).
+    /// Regular supersampling on an n × n grid of sub-pixel centres.
     Grid { n: u32 },
     /// `spp` independent uniform points.
     Random { spp: u32 },
     /// One uniform point in each cell of an n × n grid.
     Jittered { n: u32 },
+    /// Cook's 16-region correlated pattern, `passes` times.
+    Cook16 { passes: u32 },
+    /// The first `spp` Owen-scrambled Sobol points.
+    Sobol { spp: u32 },
 }
 
-/// The sampler kinds `--sampler` names.
+/// The sampler kinds `--sampler` names (`adaptive` is a render mode built on `sobol`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SamplerKind {
     #[default]
     Grid,
     Random,
     Jittered,
+    Cook16,
+    Sobol,
+}
+
+impl SamplerKind {
+    pub const NAMES: &'static str = "grid, random, jittered, cook16, sobol or adaptive";
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SamplerKind::Grid => "grid",
+            SamplerKind::Random => "random",
+            SamplerKind::Jittered => "jittered",
+            SamplerKind::Cook16 => "cook16",
+            SamplerKind::Sobol => "sobol",
+        }
+    }
 }
 
 impl std::str::FromStr for SamplerKind {
@@ -34,8 +77,11 @@ impl std::str::FromStr for SamplerKind {
             "grid" => Ok(SamplerKind::Grid),
             "random" => Ok(SamplerKind::Random),
             "jittered" => Ok(SamplerKind::Jittered),
+            "cook16" => Ok(SamplerKind::Cook16),
+            "sobol" => Ok(SamplerKind::Sobol),
             _ => Err(format!(
-                "unknown sampler `{s}`: expected grid, random or jittered"
+                "unknown sampler `{s}`: expected {}",
+                SamplerKind::NAMES
             )),
         }
     }
@@ -49,88 +95,319 @@ impl PixelSampler {
         }
     }
 
-    /// A `kind` sampler of about `spp` samples: exactly `spp` for random, the nearest
-    /// square for the grid patterns.
+    /// A `kind` sampler of about `spp` samples: exactly `spp` for random and sobol, the
+    /// nearest square for the grid patterns, the nearest multiple of 16 for cook16.
     pub fn new(kind: SamplerKind, spp: u32) -> PixelSampler {
-        let n = match PixelSampler::grid_for(spp) {
-            PixelSampler::Grid { n } => n,
-            _ => unreachable!("grid_for makes a grid"),
-        };
+        let spp = spp.clamp(1, MAX_SPP);
+        let n = ((spp as f64).sqrt().round() as u32).clamp(1, 256);
         match kind {
             SamplerKind::Grid => PixelSampler::Grid { n },
-            SamplerKind::Random => PixelSampler::Random {
-                spp: spp.clamp(1, MAX_SPP),
-            },
+            SamplerKind::Random => PixelSampler::Random { spp },
             SamplerKind::Jittered => PixelSampler::Jittered { n },
+            SamplerKind::Cook16 => PixelSampler::Cook16 {
+                passes: ((spp + 8) / 16).max(1),
+            },
+            SamplerKind::Sobol => PixelSampler::Sobol { spp },
         }
     }
 
     pub fn samples_per_pixel(&self) -> u32 {
         match *self {
             PixelSampler::Grid { n } | PixelSampler::Jittered { n } => n * n,
-            PixelSampler::Random { spp } => spp,
+            PixelSampler::Random { spp } | PixelSampler::Sobol { spp } => spp,
+            PixelSampler::Cook16 { passes } => 16 * passes,
         }
     }
 
-    /// Offset of sample `index` inside the pixel, in [0, 1)²; `rng` is the sample's own.
-    pub fn offset(&self, index: u32, rng: &mut Rng) -> (f64, f64) {
-        match *self {
+    /// The values of sample `index` of pixel (x, y).
+    pub fn stream(&self, seed: u64, x: u32, y: u32, index: u32) -> SampleStream {
+        SampleStream {
+            sampler: *self,
+            index,
+            pixel_key: mix32(seed ^ mix64(((y as u64) << 32) | x as u64)),
+            rng: Rng::for_sample(seed, x, y, index),
+            dimension: 0,
+        }
+    }
+}
+
+/// The values of one pixel sample, dimension after dimension: take [`SampleStream::pixel`]
+/// first, then 1-D and 2-D values in a fixed order (the camera's lens and time, then what the
+/// integrator needs).
+#[derive(Clone, Debug)]
+pub struct SampleStream {
+    sampler: PixelSampler,
+    index: u32,
+    /// A hash of (seed, pixel): scrambles and shuffles differ from pixel to pixel.
+    pixel_key: u32,
+    rng: Rng,
+    dimension: u32,
+}
+
+impl SampleStream {
+    /// A stream of independent uniform values only (for samples placed by other means, such
+    /// as adaptive subdivision's corners).
+    pub fn random(rng: Rng) -> SampleStream {
+        SampleStream {
+            sampler: PixelSampler::Random { spp: 1 },
+            index: 0,
+            pixel_key: 0,
+            rng,
+            dimension: 1,
+        }
+    }
+
+    /// The sample's position in the pixel, in [0, 1)²: the stream's first dimension.
+    pub fn pixel(&mut self) -> [f64; 2] {
+        debug_assert_eq!(self.dimension, 0, "the pixel position comes first");
+        self.dimension = 1;
+        let i = self.index;
+        match self.sampler {
             PixelSampler::Grid { n } => {
-                let (i, j) = (index % n, index / n);
-                ((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64)
+                let (cx, cy) = (i % n, i / n);
+                [
+                    (cx as f64 + 0.5) / n as f64,
+                    (cy as f64 + 0.5) / n as f64,
+                ]
             }
-            PixelSampler::Random { .. } => (rng.uniform(), rng.uniform()),
-            PixelSampler::Jittered { n } => {
-                let (i, j) = (index % n, index / n);
-                let (u, v) = (rng.uniform(), rng.uniform());
-                ((i as f64 + u) / n as f64, (j as f64 + v) / n as f64)
+            PixelSampler::Jittered { n } => self.cell_2d(i, n),
+            _ => self.next_2d_at(0),
+        }
+    }
+
+    /// The next 2-D value, in [0, 1)².
+    pub fn next_2d(&mut self) -> [f64; 2] {
+        self.dimension = self.dimension.max(1);
+        let d = self.dimension;
+        self.dimension += 1;
+        self.next_2d_at(d)
+    }
+
+    /// The next 1-D value, in [0, 1).
+    pub fn next_1d(&mut self) -> f64 {
+        self.dimension = self.dimension.max(1);
+        let d = self.dimension;
+        self.dimension += 1;
+        if d >= STRATIFIED_DIMENSIONS {
+            return self.rng.uniform();
+        }
+        let i = self.index;
+        match self.sampler {
+            PixelSampler::Random { .. } => self.rng.uniform(),
+            PixelSampler::Grid { n } | PixelSampler::Jittered { n } => {
+                let strata = n * n;
+                let s = permute(i, strata, self.key(d));
+                (s as f64 + self.rng.uniform()) / strata as f64
+            }
+            PixelSampler::Cook16 { .. } => {
+                let s = permute(i % 16, 16, mix32(d as u64));
+                (s as f64 + self.rng.uniform()) / 16.0
+            }
+            PixelSampler::Sobol { .. } => {
+                sobol_burley::sample(i, 0, self.key(d)) as f64
             }
         }
     }
+
+    fn next_2d_at(&mut self, d: u32) -> [f64; 2] {
+        if d >= STRATIFIED_DIMENSIONS {
+            return [self.rng.uniform(), self.rng.uniform()];
+        }
+        let i = self.index;
+        match self.sampler {
+            PixelSampler::Random { .. } => [self.rng.uniform(), self.rng.uniform()],
+            PixelSampler::Grid { n } | PixelSampler::Jittered { n } => {
+                let cell = permute(i, n * n, self.key(d));
+                self.cell_2d(cell, n)
+            }
+            PixelSampler::Cook16 { .. } => {
+                // The table is the same for every pixel (Cook's fixed pairing); the pixel
+                // itself (d = 0) takes regions in order.
+                let m = i % 16;
+                let region = if d == 0 { m } else { permute(m, 16, mix32(d as u64)) };
+                self.cell_2d(region, 4)
+            }
+            PixelSampler::Sobol { .. } => {
+                let key = self.key(d);
+                [
+                    sobol_burley::sample(i, 0, key) as f64,
+                    sobol_burley::sample(i, 1, key) as f64,
+                ]
+            }
+        }
+    }
+
+    /// A uniform point in cell `cell` of an n × n grid over [0, 1)², cells row by row.
+    fn cell_2d(&mut self, cell: u32, n: u32) -> [f64; 2] {
+        let (cx, cy) = (cell % n, cell / n);
+        let (u, v) = (self.rng.uniform(), self.rng.uniform());
+        [(cx as f64 + u) / n as f64, (cy as f64 + v) / n as f64]
+    }
+
+    /// The scramble or shuffle key of dimension `d` in this pixel.
+    fn key(&self, d: u32) -> u32 {
+        mix32(((self.pixel_key as u64) << 32) | d as u64)
+    }
+}
+
+/// A pseudo-random permutation of 0..n picked by `key`: a bijective hash on the next power
+/// of two, repeated until it lands below n (cycle walking keeps it a bijection on 0..n).
+pub fn permute(i: u32, n: u32, key: u32) -> u32 {
+    debug_assert!(i < n);
+    if n <= 1 {
+        return 0;
+    }
+    let mask = n.next_power_of_two() - 1;
+    let bits = mask.count_ones();
+    let mut x = i;
+    loop {
+        // Each step is a bijection of the `bits`-bit integers.
+        x ^= key & mask;
+        x = x.wrapping_mul(0x9E37_79B1 | 1) & mask;
+        x ^= x >> (bits / 2 + 1);
+        x = x.wrapping_add(key >> 16) & mask;
+        x = x.wrapping_mul(0x85EB_CA77) & mask;
+        x ^= x >> (bits / 3 + 1);
+        if x < n {
+            return x;
+        }
+    }
+}
+
+/// SplitMix64's finaliser.
+fn mix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58476d1ce4e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d049bb133111eb);
+    z ^ (z >> 31)
+}
+
+fn mix32(z: u64) -> u32 {
+    (mix64(z) >> 32) as u32
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    fn pixel_positions(s: PixelSampler, seed: u64) -> Vec<[f64; 2]> {
+        (0..s.samples_per_pixel())
+            .map(|i| s.stream(seed, 3, 5, i).pixel())
+            .collect()
+    }
+
     #[test]
     fn grid_covers_the_pixel_evenly() {
         let s = PixelSampler::grid_for(16);
         assert_eq!(s.samples_per_pixel(), 16);
-        let mut rng = Rng::new(0, 0);
-        let offsets: Vec<_> = (0..16).map(|i| s.offset(i, &mut rng)).collect();
-        assert_eq!(offsets[0], (0.125, 0.125));
-        assert_eq!(offsets[15], (0.875, 0.875));
-        let mean_x = offsets.iter().map(|o| o.0).sum::<f64>() / 16.0;
+        let offsets = pixel_positions(s, 0);
+        assert_eq!(offsets[0], [0.125, 0.125]);
+        assert_eq!(offsets[15], [0.875, 0.875]);
+        let mean_x = offsets.iter().map(|o| o[0]).sum::<f64>() / 16.0;
         assert!((mean_x - 0.5).abs() < 1e-15);
-        assert_eq!(PixelSampler::grid_for(1).offset(0, &mut rng), (0.5, 0.5));
+        assert_eq!(pixel_positions(PixelSampler::grid_for(1), 0)[0], [0.5, 0.5]);
     }
 
     #[test]
-    fn jittered_puts_one_sample_in_each_cell() {
-        let s = PixelSampler::new(SamplerKind::Jittered, 16);
-        assert_eq!(s, PixelSampler::Jittered { n: 4 });
-        for index in 0..16 {
-            let mut rng = Rng::for_sample(7, 3, 5, index);
-            let (x, y) = s.offset(index, &mut rng);
-            assert_eq!(((x * 4.0) as u32, (y * 4.0) as u32), (index % 4, index / 4));
+    fn permutations_are_bijections() {
+        for n in [1, 2, 3, 7, 16, 100, 1000] {
+            for key in [0, 1, 0xdead_beef, 12345] {
+                let mut seen = vec![false; n as usize];
+                for i in 0..n {
+                    let p = permute(i, n, key) as usize;
+                    assert!(!seen[p], "n {n} key {key}");
+                    seen[p] = true;
+                }
+            }
         }
+        // Different keys shuffle differently.
+        let a: Vec<u32> = (0..16).map(|i| permute(i, 16, 1)).collect();
+        let b: Vec<u32> = (0..16).map(|i| permute(i, 16, 2)).collect();
+        assert_ne!(a, b);
+    }
+
+    /// Every stratified sampler puts exactly one sample in each cell of every dimension:
+    /// the pixel, two later 2-D dimensions and a 1-D one.
+    #[test]
+    fn stratified_samplers_fill_every_cell_of_every_dimension() {
+        for s in [
+            PixelSampler::Jittered { n: 4 },
+            PixelSampler::Grid { n: 4 },
+            PixelSampler::Cook16 { passes: 1 },
+            PixelSampler::Sobol { spp: 16 },
+        ] {
+            let mut cells = vec![[[false; 16]; 3]; 2];
+            let mut strata = [false; 16];
+            for pixel in 0..2u32 {
+                for i in 0..16 {
+                    let mut st = s.stream(9, pixel, 0, i);
+                    let values = [st.pixel(), st.next_2d(), st.next_2d()];
+                    for (d, v) in values.iter().enumerate() {
+                        let c = (v[0] * 4.0) as usize + 4 * (v[1] * 4.0) as usize;
+                        assert!(!cells[pixel as usize][d][c], "{s:?} dim {d}");
+                        cells[pixel as usize][d][c] = true;
+                    }
+                    if pixel == 0 {
+                        let t = (st.next_1d() * 16.0) as usize;
+                        assert!(!strata[t], "{s:?} 1-D");
+                        strata[t] = true;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Jittered: the lens cell of a sample is not its pixel cell (shuffled per dimension);
+    /// cook16: the pairing is the same table in every pixel.
+    #[test]
+    fn jittered_shuffles_dimensions_and_cook16_pairs_them_by_a_fixed_table() {
+        let cell = |v: [f64; 2]| (v[0] * 4.0) as u32 + 4 * (v[1] * 4.0) as u32;
+        let pairs = |s: PixelSampler, x: u32| -> Vec<(u32, u32)> {
+            (0..16)
+                .map(|i| {
+                    let mut st = s.stream(1, x, 0, i);
+                    (cell(st.pixel()), cell(st.next_2d()))
+                })
+                .collect()
+        };
+        let j = PixelSampler::Jittered { n: 4 };
+        assert!(pairs(j, 0).iter().any(|(a, b)| a != b));
+        assert_ne!(pairs(j, 0), pairs(j, 1));
+        let c = PixelSampler::Cook16 { passes: 2 };
+        assert_eq!(pairs(c, 0), pairs(c, 7));
+        assert!(pairs(c, 0).iter().any(|(a, b)| a != b));
+    }
+
+    #[test]
+    fn sampler_sizes_and_names() {
+        assert_eq!(
+            PixelSampler::new(SamplerKind::Jittered, 16),
+            PixelSampler::Jittered { n: 4 }
+        );
         assert_eq!(
             PixelSampler::new(SamplerKind::Random, 10).samples_per_pixel(),
             10
         );
-        assert!("sobol"
+        assert_eq!(
+            PixelSampler::new(SamplerKind::Cook16, 40).samples_per_pixel(),
+            48
+        );
+        assert_eq!(
+            PixelSampler::new(SamplerKind::Cook16, 1).samples_per_pixel(),
+            16
+        );
+        assert_eq!("sobol".parse::<SamplerKind>(), Ok(SamplerKind::Sobol));
+        assert!("halton"
             .parse::<SamplerKind>()
             .unwrap_err()
             .contains("jittered"));
     }
 
     /// Estimating the area of a pixel below a random edge: random sampling's RMS error
-    /// falls as 1/√N; jittered sampling's faster (as N^-3/4 for edges), so it is smaller at
-    /// equal N. 4000 random edges, seeds fixed; tolerances are factors of two around the
-    /// expected ratios, many standard errors wide.
+    /// falls as 1/√N; jittered and Sobol sampling's faster (as N^-3/4 for edges), so they are
+    /// smaller at equal N. 4000 random edges, seeds fixed; tolerances are factors of two
+    /// around the expected ratios, many standard errors wide.
     #[test]
-    fn jittered_beats_random_on_edges() {
+    fn stratified_samplers_beat_random_on_edges() {
         let rmse = |kind: SamplerKind, spp: u32| {
             let sampler = PixelSampler::new(kind, spp);
             let mut edges = Rng::new(99, 1);
@@ -141,7 +418,7 @@ mod tests {
                 // by integrating over 1000 columns, which is exact enough here).
                 let a = edges.uniform();
                 let b = (edges.uniform() - 0.5) * 4.0;
-                let inside = |x: f64, y: f64| y < a + b * (x - 0.5);
+                let inside = |p: [f64; 2]| p[1] < a + b * (p[0] - 0.5);
                 let exact = (0..1000)
                     .map(|k| {
                         let x = (k as f64 + 0.5) / 1000.0;
@@ -151,11 +428,7 @@ mod tests {
                     / 1000.0;
                 let n = sampler.samples_per_pixel();
                 let hits = (0..n)
-                    .filter(|&i| {
-                        let mut rng = Rng::for_sample(5, t, 0, i);
-                        let (x, y) = sampler.offset(i, &mut rng);
-                        inside(x, y)
-                    })
+                    .filter(|&i| inside(sampler.stream(5, t, 0, i).pixel()))
                     .count();
                 let err = hits as f64 / n as f64 - exact;
                 sum += err * err;
@@ -163,14 +436,13 @@ mod tests {
             (sum / trials as f64).sqrt()
         };
         let (r16, r64) = (rmse(SamplerKind::Random, 16), rmse(SamplerKind::Random, 64));
-        let (j16, j64) = (
-            rmse(SamplerKind::Jittered, 16),
-            rmse(SamplerKind::Jittered, 64),
-        );
         // Random: 4× the samples, half the error.
         assert!((r16 / r64 - 2.0).abs() < 0.4, "random {r16} -> {r64}");
-        // Jittered: smaller than random at equal N, and falling faster.
-        assert!(j16 < 0.7 * r16 && j64 < 0.6 * r64, "jittered {j16}, {j64}");
-        assert!(j16 / j64 > 2.2, "jittered {j16} -> {j64}");
+        for kind in [SamplerKind::Jittered, SamplerKind::Sobol] {
+            let (s16, s64) = (rmse(kind, 16), rmse(kind, 64));
+            // Smaller than random at equal N, and falling faster.
+            assert!(s16 < 0.7 * r16 && s64 < 0.6 * r64, "{kind:?} {s16}, {s64}");
+            assert!(s16 / s64 > 2.2, "{kind:?} {s16} -> {s64}");
+        }
     }
 }
