@@ -405,11 +405,17 @@ fn run_render(args: RenderArgs) -> ExitCode {
     if !args.quiet {
         let c = &output.counts;
         eprintln!(
-            "loaded in {:.3} s; {}×{}, {:.2} spp on average, {:.3} s, rays: {} camera, {} shadow, {} reflection, {} refraction; {:.2} Mrays/s → {}",
+            "loaded in {:.3} s; {}×{}, {}, {:.3} s, rays: {} camera, {} shadow, {} reflection, {} refraction; {:.2} Mrays/s → {}",
             load_seconds,
             film.width,
             film.height,
-            c.camera as f64 / (film.width as f64 * film.height as f64),
+            match settings.adaptive {
+                None => format!("{} spp", settings.sampler.samples_per_pixel()),
+                Some(_) => format!(
+                    "{:.2} spp on average (adaptive)",
+                    c.camera as f64 / (film.width as f64 * film.height as f64)
+                ),
+            },
             elapsed,
             c.camera,
             c.shadow,

@@ -21,6 +21,7 @@ fn draw(loaded: &LoadedScene, spp: u32) -> plenum_core::film::Film {
         integrator: WhittedConfig::default(),
         seed: 1,
         corners: false,
+        ..Default::default()
     };
     render(
         &loaded.scene,
@@ -274,6 +275,7 @@ fn image_does_not_depend_on_thread_count() {
         integrator: WhittedConfig::default(),
         seed: 42,
         corners: false,
+        ..Default::default()
     };
     let films: Vec<Vec<[f32; 3]>> = [1, 2, 3]
         .iter()

@@ -308,7 +308,7 @@ fn inverse3(a: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
 mod tests {
     use super::*;
 
-    fn close(a: Vec3, b: Vec3, tol: f64) -> bool {
+    fn near(a: Vec3, b: Vec3, tol: f64) -> bool {
         (a - b).length() <= tol
     }
 
@@ -320,7 +320,7 @@ mod tests {
         assert_eq!(m.at(0.0), open);
         assert_eq!(m.at(1.0), close);
         let p = m.at(0.25).point(Vec3::ZERO);
-        assert!(close(p, Vec3::new(2.0, 2.0, 3.0), 1e-12), "{p:?}");
+        assert!(near(p, Vec3::new(2.0, 2.0, 3.0), 1e-12), "{p:?}");
     }
 
     /// A quarter turn about z interpolates through the eighth turn, keeping lengths (slerp,
@@ -334,7 +334,7 @@ mod tests {
         let m = Motion::new(&open, &close);
         let half = m.at(0.5).point(Vec3::X);
         let r = 2.0 / 2f64.sqrt();
-        assert!(close(half, Vec3::new(r, r, 0.0), 1e-9), "{half:?}");
+        assert!(near(half, Vec3::new(r, r, 0.0), 1e-9), "{half:?}");
         let third = m.at(1.0 / 3.0).point(Vec3::X);
         assert!((third.length() - 5.0 / 3.0).abs() < 1e-9);
         assert!((third.y.atan2(third.x).to_degrees() - 30.0).abs() < 1e-9);
@@ -348,9 +348,9 @@ mod tests {
         let other = Transform::translate(Vec3::new(3.0, 0.0, 0.0)).after(&t);
         let m = Motion::new(&t, &other);
         // Interpolating a pose with itself (as t → 0) gives the pose back.
-        let near = m.at(1e-12);
+        let start = m.at(1e-12);
         for p in [Vec3::X, Vec3::Y, Vec3::new(0.3, -2.0, 5.0)] {
-            assert!(close(near.point(p), t.point(p), 1e-9));
+            assert!(near(start.point(p), t.point(p), 1e-9));
         }
     }
 

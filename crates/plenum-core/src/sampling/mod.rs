@@ -10,7 +10,7 @@ mod pixel;
 mod rng;
 mod warp;
 
-pub use filter::{Filter, FilterKind};
+pub use filter::{Filter, FilterKind, FilterSample};
 pub use pixel::{permute, PixelSampler, SampleStream, SamplerKind, MAX_SPP};
 pub use rng::Rng;
 pub use warp::*;
