@@ -59,9 +59,11 @@ pub enum Adaptive {
     /// and trace the new corners, down to `depth` levels (at most [`MAX_SUBDIVISION`]). The
     /// pixel is the area-weighted mean of its smallest squares' corner means (a box filter).
     Subdivide { contrast: f64, depth: u32 },
-    /// Sample the pixel in batches of `min_spp` (Sobol points) until the standard error of
-    /// its luminance falls below `threshold` × max(mean, 0.05) — relative error in lit
-    /// pixels, absolute in dark ones — or `max_spp` samples are spent.
+    /// Sample every pixel with `min_spp` Sobol points; then, in batches of `min_spp`, every
+    /// pixel whose error estimate or a neighbour's is still too high, until the standard error
+    /// of its luminance falls below `threshold` × max(mean, 0.05) — relative error in lit
+    /// pixels, absolute in dark ones — or `max_spp` samples are spent. A pixel refined
+    /// because of its neighbour takes at least one batch more.
     Variance {
         threshold: f64,
         min_spp: u32,
@@ -96,55 +98,132 @@ pub fn render(
     // In corner mode the grid rendered is that of the corners, one ray each.
     let extra = u32::from(settings.corners);
     let (w, h) = (settings.width + extra, settings.height + extra);
-    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE_SIZE))
-        .flat_map(|ty| (0..w.div_ceil(TILE_SIZE)).map(move |tx| (tx * TILE_SIZE, ty * TILE_SIZE)))
-        .collect();
-    let total = tiles.len();
-    let done = std::sync::atomic::AtomicUsize::new(0);
-    let film = Mutex::new(Film::new(w, h));
-    let counts = Mutex::new(RayCounts::default());
-    let complete = AtomicBool::new(true);
-    tiles.par_iter().for_each(|&(x0, y0)| {
-        if cancel.load(Ordering::Relaxed) {
-            complete.store(false, Ordering::Relaxed);
-            return;
+    let passes = if let Some(Adaptive::Variance { .. }) = settings.adaptive {
+        2
+    } else {
+        1
+    };
+    let tiles = Tiles {
+        width: w,
+        height: h,
+        cancel,
+        progress,
+        passes,
+    };
+    let mut counts = RayCounts::default();
+    let (colors, complete) = match settings.adaptive {
+        Some(Adaptive::Variance {
+            threshold, min_spp, ..
+        }) => {
+            // First pass: min_spp samples everywhere. Second: more where the pixel or a
+            // neighbour is not yet converged (a pixel whose first samples all missed a
+            // nearby edge looks converged on its own; its neighbour gives it away).
+            let (first, done) = tiles.run(0, &mut counts, |x, y, c| {
+                let mut e = PixelEstimate::default();
+                sample_pixel(&whitted, &camera, settings, (x, y), 0..min_spp, &mut e, c, None);
+                e
+            });
+            let open: Vec<bool> = first.iter().map(|e| !e.converged(threshold)).collect();
+            let near_open = |x: u32, y: u32| {
+                let (x0, x1) = (x.saturating_sub(1), (x + 1).min(w - 1));
+                let (y0, y1) = (y.saturating_sub(1), (y + 1).min(h - 1));
+                (y0..=y1).any(|j| (x0..=x1).any(|i| open[(j * w + i) as usize]))
+            };
+            let (colors, rest) = tiles.run(1, &mut counts, |x, y, c| {
+                let mut e = first[(y * w + x) as usize].clone();
+                if done && near_open(x, y) {
+                    refine_pixel(&whitted, &camera, settings, (x, y), &mut e, c, None);
+                }
+                e.value()
+            });
+            (colors, done && rest)
         }
-        let (x1, y1) = ((x0 + TILE_SIZE).min(w), (y0 + TILE_SIZE).min(h));
-        let mut tile_counts = RayCounts::default();
-        let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-        for y in y0..y1 {
-            for x in x0..x1 {
-                let c = if settings.corners {
-                    let mut stream = corner_stream(settings.seed, x, y);
-                    let ray = camera.ray(x as f64, y as f64);
-                    whitted.camera_ray(&ray, &mut stream, &mut tile_counts, None)
-                } else {
-                    render_pixel(&whitted, &camera, settings, x, y, &mut tile_counts, None)
-                };
-                pixels.push((x, y, c));
+        _ => tiles.run(0, &mut counts, |x, y, c| {
+            if settings.corners {
+                let mut stream = corner_stream(settings.seed, x, y);
+                let ray = camera.ray(x as f64, y as f64);
+                whitted.camera_ray(&ray, &mut stream, c, None)
+            } else {
+                render_pixel(&whitted, &camera, settings, x, y, c, None)
             }
+        }),
+    };
+    let mut film = Film::new(w, h);
+    for y in 0..h {
+        for x in 0..w {
+            film.set(x, y, colors[(y * w + x) as usize]);
         }
-        {
-            let mut film = film.lock().unwrap_or_else(|e| e.into_inner());
-            for (x, y, c) in pixels {
-                film.set(x, y, c);
-            }
-        }
-        counts
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .add(&tile_counts);
-        progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-    });
-    let film = film.into_inner().unwrap_or_else(|e| e.into_inner());
+    }
     RenderOutput {
         film: if settings.corners {
             average_corners(&film)
         } else {
             film
         },
-        counts: counts.into_inner().unwrap_or_else(|e| e.into_inner()),
-        complete: complete.load(Ordering::Relaxed),
+        counts,
+        complete,
+    }
+}
+
+/// The image cut into tiles, rendered in parallel, pass after pass.
+struct Tiles<'a> {
+    width: u32,
+    height: u32,
+    cancel: &'a AtomicBool,
+    progress: &'a (dyn Fn(usize, usize) + Sync),
+    passes: usize,
+}
+
+impl Tiles<'_> {
+    /// Computes `pixel(x, y, counts)` for every pixel, tiles in parallel; returns the values
+    /// row by row and whether every tile was done (cancelled tiles get `T::default()`).
+    fn run<T: Clone + Default + Send>(
+        &self,
+        pass: usize,
+        counts: &mut RayCounts,
+        pixel: impl Fn(u32, u32, &mut RayCounts) -> T + Sync,
+    ) -> (Vec<T>, bool) {
+        let (w, h) = (self.width, self.height);
+        let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE_SIZE))
+            .flat_map(|ty| {
+                (0..w.div_ceil(TILE_SIZE)).map(move |tx| (tx * TILE_SIZE, ty * TILE_SIZE))
+            })
+            .collect();
+        let total = tiles.len() * self.passes;
+        let done = std::sync::atomic::AtomicUsize::new(tiles.len() * pass);
+        let values = Mutex::new(vec![T::default(); w as usize * h as usize]);
+        let all_counts = Mutex::new(RayCounts::default());
+        let complete = AtomicBool::new(true);
+        tiles.par_iter().for_each(|&(x0, y0)| {
+            if self.cancel.load(Ordering::Relaxed) {
+                complete.store(false, Ordering::Relaxed);
+                return;
+            }
+            let (x1, y1) = ((x0 + TILE_SIZE).min(w), (y0 + TILE_SIZE).min(h));
+            let mut tile_counts = RayCounts::default();
+            let mut tile = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    tile.push((x, y, pixel(x, y, &mut tile_counts)));
+                }
+            }
+            {
+                let mut values = values.lock().unwrap_or_else(|e| e.into_inner());
+                for (x, y, v) in tile {
+                    values[(y * w + x) as usize] = v;
+                }
+            }
+            all_counts
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .add(&tile_counts);
+            (self.progress)(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+        });
+        counts.add(&all_counts.into_inner().unwrap_or_else(|e| e.into_inner()));
+        (
+            values.into_inner().unwrap_or_else(|e| e.into_inner()),
+            complete.load(Ordering::Relaxed),
+        )
     }
 }
 
@@ -183,43 +262,92 @@ fn render_pixel(
         }
         return sum * 0.25;
     }
-    let (sampler, batch, limit) = match settings.adaptive {
+    match settings.adaptive {
         Some(Adaptive::Subdivide { contrast, depth }) => {
-            return subdivide_pixel(whitted, camera, settings, (x, y), contrast, depth, counts, tree)
+            subdivide_pixel(whitted, camera, settings, (x, y), contrast, depth, counts, tree)
         }
-        Some(Adaptive::Variance {
-            min_spp, max_spp, ..
-        }) => (PixelSampler::Sobol { spp: max_spp }, min_spp.max(2), max_spp),
+        Some(Adaptive::Variance { min_spp, .. }) => {
+            let mut e = PixelEstimate::default();
+            let first = 0..min_spp;
+            sample_pixel(whitted, camera, settings, (x, y), first, &mut e, counts, tree.as_deref_mut());
+            refine_pixel(whitted, camera, settings, (x, y), &mut e, counts, tree);
+            e.value()
+        }
         None => {
-            let n = settings.sampler.samples_per_pixel();
-            (settings.sampler, n, n)
-        }
-    };
-    let mut estimate = PixelEstimate::default();
-    let mut index = 0;
-    while index < limit {
-        for _ in 0..batch.min(limit - index) {
-            let mut stream = sampler.stream(settings.seed, x, y, index);
-            let f = settings.filter.sample(stream.pixel());
-            let lens = stream.next_2d();
-            let shutter = stream.next_1d();
-            let (px, py) = (x as f64 + 0.5 + f.dx, y as f64 + 0.5 + f.dy);
-            let ray = camera.sample_ray(px, py, lens, shutter);
-            let c = whitted.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut());
-            estimate.add(c, f.weight);
-            index += 1;
-        }
-        match settings.adaptive {
-            Some(Adaptive::Variance { threshold, .. }) if !estimate.converged(threshold) => {}
-            _ => break,
+            let mut e = PixelEstimate::default();
+            let all = 0..settings.sampler.samples_per_pixel();
+            sample_pixel(whitted, camera, settings, (x, y), all, &mut e, counts, tree);
+            e.value()
         }
     }
-    estimate.value()
+}
+
+/// Adds samples `indices` of pixel (x, y) to `estimate`: in adaptive variance mode from the
+/// Sobol sequence, otherwise from the settings' sampler.
+#[allow(clippy::too_many_arguments)]
+fn sample_pixel(
+    whitted: &Whitted,
+    camera: &Camera,
+    settings: &RenderSettings,
+    (x, y): (u32, u32),
+    indices: std::ops::Range<u32>,
+    estimate: &mut PixelEstimate,
+    counts: &mut RayCounts,
+    mut tree: Option<&mut RayTree>,
+) {
+    let sampler = match settings.adaptive {
+        Some(Adaptive::Variance { max_spp, .. }) => PixelSampler::Sobol { spp: max_spp },
+        _ => settings.sampler,
+    };
+    for index in indices {
+        let mut stream = sampler.stream(settings.seed, x, y, index);
+        let f = settings.filter.sample(stream.pixel());
+        let lens = stream.next_2d();
+        let shutter = stream.next_1d();
+        let (px, py) = (x as f64 + 0.5 + f.dx, y as f64 + 0.5 + f.dy);
+        let ray = camera.sample_ray(px, py, lens, shutter);
+        let c = whitted.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut());
+        estimate.add(c, f.weight);
+    }
+}
+
+/// Adaptive variance mode: at least one more batch of samples, then more batches until the
+/// pixel's error estimate is below the threshold or its budget is spent.
+fn refine_pixel(
+    whitted: &Whitted,
+    camera: &Camera,
+    settings: &RenderSettings,
+    pixel: (u32, u32),
+    estimate: &mut PixelEstimate,
+    counts: &mut RayCounts,
+    mut tree: Option<&mut RayTree>,
+) {
+    let Some(Adaptive::Variance {
+        threshold,
+        min_spp,
+        max_spp,
+    }) = settings.adaptive
+    else {
+        return;
+    };
+    let batch = min_spp.max(1);
+    loop {
+        let start = estimate.count;
+        let end = (start + batch).min(max_spp);
+        if start >= end {
+            return;
+        }
+        let (c, t) = (&mut *counts, tree.as_deref_mut());
+        sample_pixel(whitted, camera, settings, pixel, start..end, estimate, c, t);
+        if estimate.converged(threshold) {
+            return;
+        }
+    }
 }
 
 /// A pixel's running filter-weighted sum, and its luminance statistics for adaptive
 /// sampling.
-#[derive(Default)]
+#[derive(Clone, Default)]
 struct PixelEstimate {
     weighted: Color,
     weight: f64,
@@ -252,6 +380,9 @@ impl PixelEstimate {
 
     fn converged(&self, threshold: f64) -> bool {
         let n = self.count as f64;
+        if self.count < 2 {
+            return false;
+        }
         let mean = self.luminance / n;
         let variance = ((self.luminance_squared - n * mean * mean) / (n - 1.0)).max(0.0);
         (variance / n).sqrt() <= threshold * mean.max(0.05)
