@@ -299,3 +299,63 @@ transform_close = [{{ translate = [{half}, 0, 0] }}]
         assert!((value - expected).abs() < 0.02, "half shutter, column {x}");
     }
 }
+
+/// Every example scene of a distribution effect gives the same image, bit for bit, with 1
+/// and 3 threads: with a fixed-count sampler and a filter with negative lobes, and with
+/// both adaptive modes (whose second pass reads the first pass's neighbours).
+#[test]
+fn distribution_effects_do_not_depend_on_thread_count() {
+    use plenum_core::render::Adaptive;
+    use plenum_core::sampling::{Filter, FilterKind, SamplerKind};
+    for name in ["soft-shadows", "depth-of-field", "motion-blur", "glossy"] {
+        let loaded = plenum_scene::load_scene(Path::new(&format!("../../scenes/{name}.toml")))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let base = RenderSettings {
+            width: 40,
+            height: 30,
+            sampler: PixelSampler::new(SamplerKind::Jittered, 4),
+            filter: Filter::new(FilterKind::Mitchell, 2.0).unwrap(),
+            seed: 8,
+            ..Default::default()
+        };
+        for adaptive in [
+            None,
+            Some(Adaptive::Variance {
+                threshold: 0.05,
+                min_spp: 4,
+                max_spp: 16,
+            }),
+            Some(Adaptive::Subdivide {
+                contrast: 0.1,
+                depth: 2,
+            }),
+        ] {
+            let settings = RenderSettings {
+                adaptive,
+                ..base.clone()
+            };
+            let films: Vec<Vec<[f32; 3]>> = [1, 3]
+                .iter()
+                .map(|&n| {
+                    let pool = rayon::ThreadPoolBuilder::new()
+                        .num_threads(n)
+                        .build()
+                        .unwrap();
+                    pool.install(|| {
+                        render(
+                            &loaded.scene,
+                            &settings,
+                            &AtomicBool::new(false),
+                            &|_, _| {},
+                        )
+                        .film
+                        .pixels()
+                        .to_vec()
+                    })
+                })
+                .collect();
+            assert!(films[0] == films[1], "{name}, {adaptive:?}");
+            assert!(films[0].iter().flatten().all(|v| v.is_finite()));
+        }
+    }
+}
