@@ -66,9 +66,11 @@ struct ViewArgs {
     /// √N×√N grid), cook16 (Cook's 16 correlated regions), sobol (Owen-scrambled Sobol) or
     /// adaptive (Whitted's corner subdivision; with --noise-threshold, sampling until the
     /// error estimate is below it, between --min-spp and --spp).
-    #[arg(long, default_value = "grid")]
-    sampler: SamplerArg,
-    /// Reconstruction filter: box (the default), tent, gaussian, mitchell or lanczos.
+    /// The scene file's choice, else grid.
+    #[arg(long)]
+    sampler: Option<SamplerArg>,
+    /// Reconstruction filter: box, tent, gaussian, mitchell or lanczos (default: the scene
+    /// file's choice, else box).
     #[arg(long)]
     filter: Option<FilterKind>,
     /// Filter radius in pixels (default: 0.5 box, 1 tent, 1.5 gaussian, 2 mitchell, 3 lanczos).
@@ -236,7 +238,12 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
         eprintln!("error: --max-depth must be at most {MAX_DEPTH}");
         return Err(ExitCode::from(2));
     }
-    let kind = match view.sampler {
+    let chosen = view.sampler.unwrap_or(if d.adaptive {
+        SamplerArg::Adaptive
+    } else {
+        SamplerArg::Fixed(d.sampler)
+    });
+    let kind = match chosen {
         SamplerArg::Fixed(kind) => kind,
         SamplerArg::Adaptive => SamplerKind::Sobol,
     };
@@ -244,7 +251,7 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
     if sampler.samples_per_pixel() != spp {
         eprintln!(
             "warning: the {} sampler takes {}; using {} samples instead of {spp}",
-            view.sampler,
+            chosen,
             if kind == SamplerKind::Cook16 {
                 "multiples of 16"
             } else {
@@ -253,16 +260,19 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
             sampler.samples_per_pixel()
         );
     }
-    let filter_kind = view.filter.unwrap_or(FilterKind::Box);
-    let filter = Filter::new(
-        filter_kind,
-        view.filter_radius.unwrap_or(filter_kind.default_radius()),
-    )
+    let filter_kind = view.filter.unwrap_or(d.filter);
+    let radius = match (view.filter, view.filter_radius, d.filter_radius) {
+        (_, Some(r), _) => r,
+        // The file's radius goes with the file's filter.
+        (None, None, Some(r)) => r,
+        _ => filter_kind.default_radius(),
+    };
+    let filter = Filter::new(filter_kind, radius)
     .map_err(|e| {
         eprintln!("error: --filter-radius: {e}");
         ExitCode::from(2)
     })?;
-    let adaptive = match (view.sampler, view.noise_threshold) {
+    let adaptive = match (chosen, view.noise_threshold) {
         (SamplerArg::Fixed(_), Some(_)) => {
             eprintln!("error: --noise-threshold needs --sampler adaptive");
             return Err(ExitCode::from(2));

@@ -173,6 +173,26 @@ fn bad_scenes_give_located_errors() {
             "2:8",
             "did you mean `sphere`?",
         ),
+        (
+            "[camera]\nf_number = 2.8\n",
+            "2:12",
+            "needs a `focal_length`",
+        ),
+        ("[camera]\nblades = 2\n", "2:10", "3 to 64 blades"),
+        ("[camera]\nshutter = [1, 0]\n", "2:11", "closes (0) before it opens (1)"),
+        ("[render]\nfilter = \"sinc\"\n", "2:10", "expected box, tent"),
+        ("[render]\nsampler = \"halton\"\n", "2:11", "jittered, cook16, sobol"),
+        (
+            "[[lights]]\ntype = \"rectangle\"\ncorner = [0, 0, 0]\nedge_u = [1, 0, 0]\nedge_v = [2, 0, 0]\n",
+            "5:10",
+            "no area",
+        ),
+        ("[materials.m]\ngloss = 0\n", "2:9", "positive"),
+        (
+            "[materials.x]\n[[objects]]\ntype = \"mesh\"\npositions = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\nindices = [[0, 1, 2]]\nemission = 1\nmaterial = \"x\"\n",
+            "6:12",
+            "drop `material`",
+        ),
     ];
     for (i, (text, location, message)) in cases.iter().enumerate() {
         let scene = write(&dir, &format!("bad{i}.toml"), text);

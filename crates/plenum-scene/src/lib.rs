@@ -25,6 +25,12 @@ pub struct RenderDefaults {
     pub width: u32,
     pub height: u32,
     pub spp: u32,
+    /// The pixel sampler, and whether sampling is adaptive (`sampler = "adaptive"`).
+    pub sampler: plenum_core::sampling::SamplerKind,
+    pub adaptive: bool,
+    pub filter: plenum_core::sampling::FilterKind,
+    /// `None`: the filter's own default radius.
+    pub filter_radius: Option<f64>,
     pub max_depth: u32,
     pub min_weight: f64,
     /// Stops of exposure applied before clamping to 8 bits.
@@ -39,6 +45,10 @@ impl Default for RenderDefaults {
             width: 640,
             height: 480,
             spp: 1,
+            sampler: plenum_core::sampling::SamplerKind::Grid,
+            adaptive: false,
+            filter: plenum_core::sampling::FilterKind::Box,
+            filter_radius: None,
             max_depth: 5,
             min_weight: 1.0 / 256.0,
             exposure: 0.0,

@@ -122,8 +122,36 @@ impl<'s> Reader<'s> {
         let f = self.src.table(
             v,
             "[render]",
-            &["spp", "max_depth", "min_weight", "exposure"],
+            &[
+                "spp",
+                "sampler",
+                "filter",
+                "filter_radius",
+                "max_depth",
+                "min_weight",
+                "exposure",
+            ],
         )?;
+        if let Some(v) = f.get("sampler") {
+            match self.src.string(v)? {
+                "adaptive" => d.adaptive = true,
+                name => {
+                    d.sampler = name
+                        .parse()
+                        .map_err(|e: String| self.src.error(v.span(), e))?
+                }
+            }
+        }
+        if let Some(v) = f.get("filter") {
+            d.filter = self
+                .src
+                .string(v)?
+                .parse()
+                .map_err(|e: String| self.src.error(v.span(), e))?;
+        }
+        if f.get("filter_radius").is_some() {
+            d.filter_radius = Some(f.positive("filter_radius", None)?);
+        }
         if let Some(spp) = f.count("spp")? {
             if spp == 0 || spp > MAX_SPP {
                 return Err(self.src.error(

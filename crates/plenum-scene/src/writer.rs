@@ -22,9 +22,22 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
     let _ = writeln!(w, "background = {}\n", color(scene.background));
     let _ = writeln!(
         w,
-        "[render]\nspp = {}\nmax_depth = {}\nmin_weight = {:?}\nexposure = {:?}\n",
-        defaults.spp, defaults.max_depth, defaults.min_weight, defaults.exposure
+        "[render]\nspp = {}\nsampler = \"{}\"\nfilter = \"{}\"\nmax_depth = {}\nmin_weight = {:?}\nexposure = {:?}",
+        defaults.spp,
+        if defaults.adaptive {
+            "adaptive"
+        } else {
+            defaults.sampler.name()
+        },
+        defaults.filter.name(),
+        defaults.max_depth,
+        defaults.min_weight,
+        defaults.exposure
     );
+    if let Some(r) = defaults.filter_radius {
+        let _ = writeln!(w, "filter_radius = {r:?}");
+    }
+    let _ = writeln!(w);
     let c = &scene.camera;
     let _ = writeln!(
         w,

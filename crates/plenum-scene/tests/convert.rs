@@ -76,6 +76,10 @@ fn converted_scenes_render_the_same() {
         "instances.toml",
         "textures.toml",
         "shadows.toml",
+        "soft-shadows.toml",
+        "depth-of-field.toml",
+        "motion-blur.toml",
+        "glossy.toml",
     ] {
         round_trip(load_scene(&examples.join(name)).unwrap(), name);
     }
