@@ -289,6 +289,38 @@ transform_close = [{{ translate = [{half}, 0, 0] }}]
             "column {x}: {value} vs {expected}"
         );
     }
+    // The camera moving the other way instead gives the same ramp: only relative motion
+    // counts.
+    let mut camera_moves = scene(&format!(
+        r#"
+[camera]
+position = [{half}, 0, 0]
+look_at = [{half}, 0, -1]
+position_close = [-{half}, 0, 0]
+look_at_close = [-{half}, 0, -1]
+fov = {fov}
+resolution = [{width}, {height}]
+
+[materials.white]
+emissive = 1
+diffuse = 0
+ambient = 0
+
+[[objects]]
+type = "polygon"
+material = "white"
+vertices = [[0, -50, -{depth}], [50, -50, -{depth}], [50, 50, -{depth}], [0, 50, -{depth}]]
+"#,
+        half = travel / 2.0
+    ));
+    let moving_camera = film_row_means(&camera_moves, &settings);
+    for (x, (a, b)) in moving_camera.iter().zip(&row).enumerate() {
+        assert!((a - b).abs() < 0.02, "moving camera, column {x}: {a} vs {b}");
+    }
+    camera_moves.scene.camera.motion = None;
+    let still = film_row_means(&camera_moves, &settings);
+    assert!(still.iter().all(|&v| v == 0.0 || v == 1.0), "a still camera sees a sharp edge");
+
     // Half a shutter: half the ramp.
     let mut half_open = loaded;
     half_open.scene.camera.shutter = [0.0, 0.5];
