@@ -267,8 +267,7 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
         (None, None, Some(r)) => r,
         _ => filter_kind.default_radius(),
     };
-    let filter = Filter::new(filter_kind, radius)
-    .map_err(|e| {
+    let filter = Filter::new(filter_kind, radius).map_err(|e| {
         eprintln!("error: --filter-radius: {e}");
         ExitCode::from(2)
     })?;

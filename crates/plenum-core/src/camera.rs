@@ -153,7 +153,8 @@ impl Camera {
 
     /// The direction through raster (x, y), with unit length along the view direction.
     fn direction(&self, f: &Frame, x: f64, y: f64) -> Vec3 {
-        f.forward + f.right * (x * self.pixel_size - self.half_width)
+        f.forward
+            + f.right * (x * self.pixel_size - self.half_width)
             + f.up * (self.half_height - y * self.pixel_size)
     }
 

@@ -10,7 +10,9 @@
 
 use crate::color::Color;
 use crate::math::Vec3;
-use crate::sampling::{concentric_disk, uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_triangle, Frame};
+use crate::sampling::{
+    concentric_disk, uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_triangle, Frame,
+};
 
 /// Distance attenuation f(d) = min(1, 1 / (a + b·d + c·d²)).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -85,7 +87,10 @@ pub enum Emitter {
         normal: Vec3,
         radius: f64,
     },
-    Sphere { center: Vec3, radius: f64 },
+    Sphere {
+        center: Vec3,
+        radius: f64,
+    },
     /// Triangles, picked in proportion to their area.
     Triangles {
         triangles: Vec<[Vec3; 3]>,
@@ -330,7 +335,13 @@ mod tests {
                 quadratic: 1.0,
             },
         };
-        let at = |d: f64| light.incident(Vec3::new(d, 0.0, 0.0), [0.5; 2]).unwrap().intensity.r;
+        let at = |d: f64| {
+            light
+                .incident(Vec3::new(d, 0.0, 0.0), [0.5; 2])
+                .unwrap()
+                .intensity
+                .r
+        };
         assert!((at(2.0) / at(4.0) - 4.0).abs() < 1e-12);
         assert!((at(3.0) - 1.0 / 9.0).abs() < 1e-15);
         // min(1, ·) keeps it finite up close.
@@ -396,7 +407,13 @@ mod tests {
         }
 
         /// Solid-angle pdf of uniform area sampling of a planar patch hit along w at all.
-        fn planar_pdf(w: Vec3, point: Vec3, normal: Vec3, area: f64, inside: impl Fn(Vec3) -> bool) -> f64 {
+        fn planar_pdf(
+            w: Vec3,
+            point: Vec3,
+            normal: Vec3,
+            area: f64,
+            inside: impl Fn(Vec3) -> bool,
+        ) -> f64 {
             let s = point.dot(normal) / w.dot(normal);
             if !(s > 0.0) || !inside(w * s) {
                 return 0.0;
@@ -406,11 +423,19 @@ mod tests {
 
         #[test]
         fn chi_square_rectangle_light() {
-            let (corner, eu, ev) = (Vec3::new(-1.0, -0.5, 2.0), Vec3::new(2.5, 0.0, 0.5), Vec3::new(0.0, 1.5, 0.0));
+            let (corner, eu, ev) = (
+                Vec3::new(-1.0, -0.5, 2.0),
+                Vec3::new(2.5, 0.0, 0.5),
+                Vec3::new(0.0, 1.5, 0.0),
+            );
             let normal = eu.cross(ev).normalized();
             let area = eu.cross(ev).length();
             check(
-                Emitter::Rectangle { corner, edge_u: eu, edge_v: ev },
+                Emitter::Rectangle {
+                    corner,
+                    edge_u: eu,
+                    edge_v: ev,
+                },
                 |w| {
                     planar_pdf(w, corner, normal, area, |q| {
                         let d = q - corner;
@@ -424,10 +449,26 @@ mod tests {
 
         #[test]
         fn chi_square_disk_light() {
-            let (center, normal, radius) = (Vec3::new(0.3, 0.2, 2.0), Vec3::new(0.2, 0.1, -1.0).normalized(), 0.9);
+            let (center, normal, radius) = (
+                Vec3::new(0.3, 0.2, 2.0),
+                Vec3::new(0.2, 0.1, -1.0).normalized(),
+                0.9,
+            );
             check(
-                Emitter::Disk { center, normal, radius },
-                |w| planar_pdf(w, center, normal, std::f64::consts::PI * radius * radius, |q| (q - center).length() <= radius),
+                Emitter::Disk {
+                    center,
+                    normal,
+                    radius,
+                },
+                |w| {
+                    planar_pdf(
+                        w,
+                        center,
+                        normal,
+                        std::f64::consts::PI * radius * radius,
+                        |q| (q - center).length() <= radius,
+                    )
+                },
                 "disk light",
             );
         }
@@ -454,8 +495,16 @@ mod tests {
         #[test]
         fn chi_square_triangle_mesh_light() {
             let triangles = vec![
-                [Vec3::new(-1.0, -1.0, 2.0), Vec3::new(0.5, -1.0, 2.0), Vec3::new(-1.0, 0.8, 2.5)],
-                [Vec3::new(0.6, 0.0, 1.5), Vec3::new(1.2, 0.0, 1.5), Vec3::new(0.6, 0.5, 1.5)],
+                [
+                    Vec3::new(-1.0, -1.0, 2.0),
+                    Vec3::new(0.5, -1.0, 2.0),
+                    Vec3::new(-1.0, 0.8, 2.5),
+                ],
+                [
+                    Vec3::new(0.6, 0.0, 1.5),
+                    Vec3::new(1.2, 0.0, 1.5),
+                    Vec3::new(0.6, 0.5, 1.5),
+                ],
             ];
             let shape = Emitter::triangles(triangles.clone()).unwrap();
             let total = shape.area();

@@ -120,7 +120,16 @@ pub fn render(
             // nearby edge looks converged on its own; its neighbour gives it away).
             let (first, done) = tiles.run(0, &mut counts, |x, y, c| {
                 let mut e = PixelEstimate::default();
-                sample_pixel(&whitted, &camera, settings, (x, y), 0..min_spp, &mut e, c, None);
+                sample_pixel(
+                    &whitted,
+                    &camera,
+                    settings,
+                    (x, y),
+                    0..min_spp,
+                    &mut e,
+                    c,
+                    None,
+                );
                 e
             });
             let open: Vec<bool> = first.iter().map(|e| !e.converged(threshold)).collect();
@@ -263,13 +272,29 @@ fn render_pixel(
         return sum * 0.25;
     }
     match settings.adaptive {
-        Some(Adaptive::Subdivide { contrast, depth }) => {
-            subdivide_pixel(whitted, camera, settings, (x, y), contrast, depth, counts, tree)
-        }
+        Some(Adaptive::Subdivide { contrast, depth }) => subdivide_pixel(
+            whitted,
+            camera,
+            settings,
+            (x, y),
+            contrast,
+            depth,
+            counts,
+            tree,
+        ),
         Some(Adaptive::Variance { min_spp, .. }) => {
             let mut e = PixelEstimate::default();
             let first = 0..min_spp;
-            sample_pixel(whitted, camera, settings, (x, y), first, &mut e, counts, tree.as_deref_mut());
+            sample_pixel(
+                whitted,
+                camera,
+                settings,
+                (x, y),
+                first,
+                &mut e,
+                counts,
+                tree.as_deref_mut(),
+            );
             refine_pixel(whitted, camera, settings, (x, y), &mut e, counts, tree);
             e.value()
         }
@@ -411,7 +436,12 @@ fn subdivide_pixel(
             let (fx, fy) = (i as f64 / step as f64, j as f64 / step as f64);
             let index = (j * SIDE + i) as u32;
             let mut stream = SampleStream::random(Rng::for_sample(settings.seed, x, y, index));
-            let ray = camera.sample_ray(x as f64 + fx, y as f64 + fy, stream.next_2d(), stream.next_1d());
+            let ray = camera.sample_ray(
+                x as f64 + fx,
+                y as f64 + fy,
+                stream.next_2d(),
+                stream.next_1d(),
+            );
             whitted.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut())
         })
     };
@@ -430,9 +460,11 @@ fn subdivide_pixel(
             corner(i + side, j + side, counts),
         ];
         let lum = c.map(|c| c.luminance());
-        let (lo, hi) = lum.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-            (lo.min(v), hi.max(v))
-        });
+        let (lo, hi) = lum
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            });
         let differ = hi - lo > contrast * (hi + lo).max(1e-6);
         if differ && level < depth {
             let half = side / 2;

@@ -390,7 +390,11 @@ impl SceneBuilder {
     /// Makes the last object added move from its transform at time 0 to `close` at time 1.
     pub fn set_last_motion(&mut self, close: Transform) {
         if let Some(p) = self.primitives.last_mut() {
-            let open = p.to_world.as_deref().copied().unwrap_or(Transform::IDENTITY);
+            let open = p
+                .to_world
+                .as_deref()
+                .copied()
+                .unwrap_or(Transform::IDENTITY);
             if open != close {
                 p.motion = Some(Box::new(Motion::new(&open, &close)));
             }
@@ -432,7 +436,8 @@ impl SceneBuilder {
             Emitter::Triangles { .. } => None,
         };
         let object = shape.map(|shape| {
-            let material = self.add_material(format!("{name} (emitter)"), Material::emitter(radiance));
+            let material =
+                self.add_material(format!("{name} (emitter)"), Material::emitter(radiance));
             self.add_object(name.clone(), shape, Transform::IDENTITY, material);
             (self.primitives.len() - 1) as u32
         });

@@ -104,7 +104,7 @@ fn zero_material() -> Material {
         transmissive: black(),
         ior: 1.0,
         fresnel: false,
-                    gloss: None,
+        gloss: None,
     }
 }
 

@@ -49,11 +49,7 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
         defaults.width,
         defaults.height
     );
-    let _ = writeln!(
-        w,
-        "shutter = [{:?}, {:?}]",
-        c.shutter[0], c.shutter[1]
-    );
+    let _ = writeln!(w, "shutter = [{:?}, {:?}]", c.shutter[0], c.shutter[1]);
     if c.lens.radius > 0.0 {
         let _ = writeln!(
             w,
@@ -169,11 +165,7 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                     ),
                     Emitter::Triangles { .. } => Ok(()),
                 };
-                let _ = writeln!(
-                    w,
-                    "color = {}\nsamples = {samples}\n",
-                    color(*radiance)
-                );
+                let _ = writeln!(w, "color = {}\nsamples = {samples}\n", color(*radiance));
             }
             Light::Point {
                 position,
@@ -286,7 +278,11 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
             let _ = writeln!(w, "transform = [{{ matrix = {} }}]", matrix(t));
         }
         if let Some(m) = &p.motion {
-            let _ = writeln!(w, "transform_close = [{{ matrix = {} }}]", matrix(&m.at(1.0)));
+            let _ = writeln!(
+                w,
+                "transform_close = [{{ matrix = {} }}]",
+                matrix(&m.at(1.0))
+            );
         }
         let _ = writeln!(w);
     }

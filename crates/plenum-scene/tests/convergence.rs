@@ -19,12 +19,7 @@ const SAMPLERS: [SamplerKind; 5] = [
 
 /// Luminance per pixel, and the camera rays spent.
 fn draw(loaded: &LoadedScene, settings: &RenderSettings) -> (Vec<f64>, u64) {
-    let out = render(
-        &loaded.scene,
-        settings,
-        &AtomicBool::new(false),
-        &|_, _| {},
-    );
+    let out = render(&loaded.scene, settings, &AtomicBool::new(false), &|_, _| {});
     let film = &out.film;
     let mut values = Vec::new();
     for y in 0..film.height {
@@ -98,7 +93,11 @@ fn checkerboard_to_the_horizon() {
             "| {} | {} |",
             kind.name(),
             e.iter()
-                .map(|v| if v.is_nan() { "–".to_string() } else { format!("{v:.4}") })
+                .map(|v| if v.is_nan() {
+                    "–".to_string()
+                } else {
+                    format!("{v:.4}")
+                })
                 .collect::<Vec<_>>()
                 .join(" | ")
         );
@@ -168,7 +167,11 @@ radius = 0.8
     let counts = [16, 64, 256];
     println!("smooth penumbra, 32×32: RMSE at 16, 64, 256 spp");
     let mut all = Vec::new();
-    for kind in [SamplerKind::Random, SamplerKind::Jittered, SamplerKind::Sobol] {
+    for kind in [
+        SamplerKind::Random,
+        SamplerKind::Jittered,
+        SamplerKind::Sobol,
+    ] {
         let e = errors(&loaded, size, &reference, kind, &counts);
         println!("{}: {e:.5?}", kind.name());
         all.push(e);
@@ -223,7 +226,10 @@ vertices = [[0.2, -2, -1], [2.6, -1.5, -1], [1.8, 1.9, -1]]
     )
     .unwrap();
     let (w, h) = (64, 48);
-    let (reference, _) = draw(&loaded, &settings(w, h, PixelSampler::Sobol { spp: 4096 }, 99));
+    let (reference, _) = draw(
+        &loaded,
+        &settings(w, h, PixelSampler::Sobol { spp: 4096 }, 99),
+    );
     let (uniform, uniform_rays) = draw(
         &loaded,
         &settings(w, h, PixelSampler::new(SamplerKind::Jittered, 16), 11),
@@ -250,7 +256,13 @@ vertices = [[0.2, -2, -1], [2.6, -1.5, -1], [1.8, 1.9, -1]]
             "{adaptive:?}: RMSE {error:.4} with {:.2} spp; jittered 16 spp: {uniform_error:.4}",
             rays as f64 / (w * h) as f64
         );
-        assert!(error <= uniform_error, "{adaptive:?}: {error} vs {uniform_error}");
-        assert!(2 * rays <= uniform_rays, "{adaptive:?}: {rays} rays vs {uniform_rays}");
+        assert!(
+            error <= uniform_error,
+            "{adaptive:?}: {error} vs {uniform_error}"
+        );
+        assert!(
+            2 * rays <= uniform_rays,
+            "{adaptive:?}: {rays} rays vs {uniform_rays}"
+        );
     }
 }

@@ -277,7 +277,22 @@ fn image_does_not_depend_on_thread_count() {
         corners: false,
         ..Default::default()
     };
-    let films: Vec<Vec<[f32; 3]>> = [1, 2, 3]
+    let films = films_with_threads(&loaded, &settings, &[1, 2, 3]);
+    assert!(
+        films[0].iter().any(|p| p[0] > 0.1),
+        "the image must not be black"
+    );
+    assert_eq!(films[0], films[1]);
+    assert_eq!(films[0], films[2]);
+}
+
+/// The image rendered with each thread count.
+fn films_with_threads(
+    loaded: &LoadedScene,
+    settings: &RenderSettings,
+    threads: &[usize],
+) -> Vec<Vec<[f32; 3]>> {
+    threads
         .iter()
         .map(|&n| {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -285,22 +300,52 @@ fn image_does_not_depend_on_thread_count() {
                 .build()
                 .unwrap();
             pool.install(|| {
-                render(
-                    &loaded.scene,
-                    &settings,
-                    &AtomicBool::new(false),
-                    &|_, _| {},
-                )
-                .film
-                .pixels()
-                .to_vec()
+                render(&loaded.scene, settings, &AtomicBool::new(false), &|_, _| {})
+                    .film
+                    .pixels()
+                    .to_vec()
             })
         })
-        .collect();
-    assert!(
-        films[0].iter().any(|p| p[0] > 0.1),
-        "the image must not be black"
-    );
-    assert_eq!(films[0], films[1]);
-    assert_eq!(films[0], films[2]);
+        .collect()
+}
+
+/// Every example scene of a distribution effect gives the same image, bit for bit, with 1
+/// and 3 threads: with a fixed-count sampler and a filter with negative lobes, and with
+/// both adaptive modes (whose second pass reads the first pass's neighbours).
+#[test]
+fn distribution_effects_do_not_depend_on_thread_count() {
+    use plenum_core::render::Adaptive;
+    use plenum_core::sampling::{Filter, FilterKind, SamplerKind};
+    for name in ["soft-shadows", "depth-of-field", "motion-blur", "glossy"] {
+        let loaded = plenum_scene::load_scene(Path::new(&format!("../../scenes/{name}.toml")))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let base = RenderSettings {
+            width: 40,
+            height: 30,
+            sampler: PixelSampler::new(SamplerKind::Jittered, 4),
+            filter: Filter::new(FilterKind::Mitchell, 2.0).unwrap(),
+            seed: 8,
+            ..Default::default()
+        };
+        for adaptive in [
+            None,
+            Some(Adaptive::Variance {
+                threshold: 0.05,
+                min_spp: 4,
+                max_spp: 16,
+            }),
+            Some(Adaptive::Subdivide {
+                contrast: 0.1,
+                depth: 2,
+            }),
+        ] {
+            let settings = RenderSettings {
+                adaptive,
+                ..base.clone()
+            };
+            let films = films_with_threads(&loaded, &settings, &[1, 3]);
+            assert!(films[0] == films[1], "{name}, {adaptive:?}");
+            assert!(films[0].iter().flatten().all(|v| v.is_finite()));
+        }
+    }
 }

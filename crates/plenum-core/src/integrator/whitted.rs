@@ -252,7 +252,8 @@ impl<'a> Whitted<'a> {
                 continue;
             };
             if let Some(exponent) = k.gloss {
-                let lobe = Frame::from_z(direction).to_world(phong_lobe(stream.next_2d(), exponent));
+                let lobe =
+                    Frame::from_z(direction).to_world(phong_lobe(stream.next_2d(), exponent));
                 // Reflected rays stay above the surface, refracted ones go below.
                 let above = lobe.dot(n) > 0.0;
                 if above != (kind == RayKind::Reflected) {

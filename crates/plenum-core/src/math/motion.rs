@@ -57,31 +57,19 @@ impl Quaternion {
             let s = (1.0 + m[0][0] - m[1][1] - m[2][2]).sqrt() * 2.0;
             Quaternion {
                 w: (m[2][1] - m[1][2]) / s,
-                v: Vec3::new(
-                    0.25 * s,
-                    (m[0][1] + m[1][0]) / s,
-                    (m[0][2] + m[2][0]) / s,
-                ),
+                v: Vec3::new(0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s),
             }
         } else if m[1][1] > m[2][2] {
             let s = (1.0 + m[1][1] - m[0][0] - m[2][2]).sqrt() * 2.0;
             Quaternion {
                 w: (m[0][2] - m[2][0]) / s,
-                v: Vec3::new(
-                    (m[0][1] + m[1][0]) / s,
-                    0.25 * s,
-                    (m[1][2] + m[2][1]) / s,
-                ),
+                v: Vec3::new((m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s),
             }
         } else {
             let s = (1.0 + m[2][2] - m[0][0] - m[1][1]).sqrt() * 2.0;
             Quaternion {
                 w: (m[1][0] - m[0][1]) / s,
-                v: Vec3::new(
-                    (m[0][2] + m[2][0]) / s,
-                    (m[1][2] + m[2][1]) / s,
-                    0.25 * s,
-                ),
+                v: Vec3::new((m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s),
             }
         };
         q.normalized()
@@ -222,12 +210,12 @@ impl Motion {
         let r = a.rotation.slerp(b.rotation, time).to_rotation();
         let t = a.translation + (b.translation - a.translation) * time;
         let mut m = Matrix4::IDENTITY;
-        for i in 0..3 {
-            for j in 0..3 {
-                m.0[i][j] = (0..3)
+        for (row, r_row) in m.0.iter_mut().zip(&r) {
+            for (j, m_ij) in row.iter_mut().take(3).enumerate() {
+                *m_ij = (0..3)
                     .map(|k| {
                         let s = a.stretch[k][j] + (b.stretch[k][j] - a.stretch[k][j]) * time;
-                        r[i][k] * s
+                        r_row[k] * s
                     })
                     .sum();
             }
@@ -280,7 +268,8 @@ impl Motion {
 }
 
 fn det3(a: &[[f64; 3]; 3]) -> f64 {
-    a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+    a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+        - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
         + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
 }
 

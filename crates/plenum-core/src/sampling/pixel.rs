@@ -165,10 +165,7 @@ impl SampleStream {
         match self.sampler {
             PixelSampler::Grid { n } => {
                 let (cx, cy) = (i % n, i / n);
-                [
-                    (cx as f64 + 0.5) / n as f64,
-                    (cy as f64 + 0.5) / n as f64,
-                ]
+                [(cx as f64 + 0.5) / n as f64, (cy as f64 + 0.5) / n as f64]
             }
             PixelSampler::Jittered { n } => self.cell_2d(i, n),
             _ => self.next_2d_at(0),
@@ -203,9 +200,7 @@ impl SampleStream {
                 let s = permute(i % 16, 16, mix32(d as u64));
                 (s as f64 + self.rng.uniform()) / 16.0
             }
-            PixelSampler::Sobol { .. } => {
-                sobol_burley::sample(i, 0, self.key(d)) as f64
-            }
+            PixelSampler::Sobol { .. } => sobol_burley::sample(i, 0, self.key(d)) as f64,
         }
     }
 
@@ -224,7 +219,11 @@ impl SampleStream {
                 // The table is the same for every pixel (Cook's fixed pairing); the pixel
                 // itself (d = 0) takes regions in order.
                 let m = i % 16;
-                let region = if d == 0 { m } else { permute(m, 16, mix32(d as u64)) };
+                let region = if d == 0 {
+                    m
+                } else {
+                    permute(m, 16, mix32(d as u64))
+                };
                 self.cell_2d(region, 4)
             }
             PixelSampler::Sobol { .. } => {
@@ -335,7 +334,7 @@ mod tests {
             PixelSampler::Cook16 { passes: 1 },
             PixelSampler::Sobol { spp: 16 },
         ] {
-            let mut cells = vec![[[false; 16]; 3]; 2];
+            let mut cells = [[[false; 16]; 3]; 2];
             let mut strata = [false; 16];
             for pixel in 0..2u32 {
                 for i in 0..16 {
