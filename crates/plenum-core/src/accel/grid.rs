@@ -2,6 +2,10 @@
 //! (1987), with mailboxing so an item filed in several cells is tested once per ray.
 //! The resolution follows the usual heuristic: cells of equal size along each axis,
 //! about λ·N of them in all (∛(λN/V) per unit length).
+//!
+//! Most of a ray's cells are empty, and stepping through them one by one is most of the
+//! cost. So the grid also keeps which blocks of 4 × 4 × 4 cells (macro cells) hold anything,
+//! and a ray crosses an empty block in one jump to its far wall.
 
 use super::mailbox::{new_owner, Mailbox};
 use crate::math::{Bounds3, Ray, Vec3};
@@ -9,6 +13,8 @@ use crate::math::{Bounds3, Ray, Vec3};
 /// Cells per item.
 const LAMBDA: f64 = 1.5;
 const MAX_RESOLUTION: usize = 512;
+/// Cells per macro cell along each axis (a power of two).
+const MACRO: usize = 4;
 
 #[derive(Clone, Debug)]
 pub struct Grid {
@@ -18,6 +24,9 @@ pub struct Grid {
     /// Items of cell c are `items[starts[c]..starts[c + 1]]`.
     starts: Vec<u32>,
     items: Vec<u32>,
+    /// Per macro cell: some cell of it holds an item.
+    macro_full: Vec<bool>,
+    macro_resolution: [usize; 3],
     item_count: usize,
     owner: u64,
 }
@@ -36,6 +45,8 @@ impl Grid {
             cell_size: Vec3::ONE,
             starts: vec![0, 0],
             items: Vec::new(),
+            macro_full: vec![true],
+            macro_resolution: [1; 3],
             item_count: item_bounds.len(),
             owner: new_owner(),
         };
@@ -85,6 +96,16 @@ impl Grid {
                 fill[c] += 1;
             });
         }
+        grid.macro_resolution = grid.resolution.map(|r| r.div_ceil(MACRO));
+        let [mx, my, mz] = grid.macro_resolution;
+        grid.macro_full = vec![false; mx * my * mz];
+        let [nx, ny, _] = grid.resolution;
+        for c in 0..cell_count {
+            if counts[c + 1] > counts[c] {
+                let (x, y, z) = (c % nx, (c / nx) % ny, c / (nx * ny));
+                grid.macro_full[((z / MACRO) * my + y / MACRO) * mx + x / MACRO] = true;
+            }
+        }
         grid.starts = counts;
         grid.items = items;
         grid
@@ -99,7 +120,7 @@ impl Grid {
     }
 
     pub fn memory_bytes(&self) -> usize {
-        (self.starts.len() + self.items.len()) * 4
+        (self.starts.len() + self.items.len()) * 4 + self.macro_full.len()
     }
 
     /// The cell of a point along one axis, clamped to the grid.
@@ -108,8 +129,13 @@ impl Grid {
         if size <= 0.0 {
             return 0;
         }
-        let c = ((x - self.bounds.min[axis]) / size).floor();
-        (c.max(0.0) as usize).min(self.resolution[axis] - 1)
+        // Truncation is floor here (c ≥ 0), without a call into libm.
+        let c = (x - self.bounds.min[axis]) / size;
+        if c > 0.0 {
+            (c as usize).min(self.resolution[axis] - 1)
+        } else {
+            0
+        }
     }
 
     fn for_cells(&self, b: &Bounds3, mut f: impl FnMut(usize)) {
@@ -157,7 +183,70 @@ impl Grid {
         }
         let mailbox = Mailbox::start(self.owner, self.item_count);
         let [nx, ny, _] = self.resolution;
+        let [mx, my, _] = self.macro_resolution;
         loop {
+            let m = ((cell[2] / MACRO) * my + cell[1] / MACRO) * mx + cell[0] / MACRO;
+            if !self.macro_full[m] {
+                // Jump across the empty macro cell: find the axis whose macro wall comes
+                // first, move there, and bring the other axes up to that time.
+                let walls = [0, 1, 2].map(|a| {
+                    let first = cell[a] / MACRO * MACRO;
+                    let last = (first + MACRO).min(self.resolution[a]) - 1;
+                    if step[a] > 0 {
+                        last - cell[a]
+                    } else {
+                        cell[a] - first
+                    }
+                });
+                // An axis the ray does not move along is never crossed (and 0 · ∞ is NaN).
+                let crossing = [0, 1, 2].map(|a| {
+                    if step[a] == 0 {
+                        f64::INFINITY
+                    } else {
+                        next[a] + walls[a] as f64 * delta[a]
+                    }
+                });
+                let a = if crossing[0] < crossing[1] {
+                    if crossing[0] < crossing[2] {
+                        0
+                    } else {
+                        2
+                    }
+                } else if crossing[1] < crossing[2] {
+                    1
+                } else {
+                    2
+                };
+                let t_out = crossing[a];
+                if t_max < t_out || t_out > t_exit {
+                    return;
+                }
+                for b in 0..3 {
+                    if b == a || step[b] == 0 {
+                        continue;
+                    }
+                    // Walls crossed before t_out, rounded down: being a cell behind only
+                    // visits an empty cell; being a cell ahead could skip a full one.
+                    let x = (t_out - next[b]) / delta[b];
+                    let x = x - 1e-9 * (1.0 + x);
+                    let crossed = if x > 0.0 {
+                        // ⌈x⌉ without a call into libm.
+                        let whole = x as usize;
+                        (whole + usize::from((whole as f64) < x)).min(walls[b])
+                    } else {
+                        0
+                    };
+                    cell[b] = (cell[b] as isize + step[b] * crossed as isize) as usize;
+                    next[b] += crossed as f64 * delta[b];
+                }
+                let moved = cell[a] as isize + step[a] * (walls[a] as isize + 1);
+                if moved < 0 || moved >= self.resolution[a] as isize {
+                    return;
+                }
+                cell[a] = moved as usize;
+                next[a] = t_out + delta[a];
+                continue;
+            }
             let c = (cell[2] * ny + cell[1]) * nx + cell[0];
             let items = &self.items[self.starts[c] as usize..self.starts[c + 1] as usize];
             if !mailbox.visit_untested(items, &mut t_max, &mut visit) {

@@ -5,6 +5,7 @@
 //! scene's.
 
 use std::cell::RefCell;
+use std::rc::Rc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 static NEXT_OWNER: AtomicU64 = AtomicU64::new(1);
@@ -15,11 +16,16 @@ pub fn new_owner() -> u64 {
 }
 
 struct Stamps {
-    owner: u64,
     ray: u32,
     stamps: Vec<u32>,
+}
+
+/// One structure's stamps on this thread.
+struct Entry {
+    owner: u64,
     /// When this thread last used them, for evicting the least recently used.
     used: u64,
+    stamps: Rc<RefCell<Stamps>>,
 }
 
 /// Candidates handed to the caller at a time.
@@ -29,57 +35,61 @@ const CHUNK: usize = 16;
 const KEPT: usize = 32;
 
 thread_local! {
-    static MAILBOXES: RefCell<(u64, Vec<Stamps>)> = const { RefCell::new((0, Vec::new())) };
+    static MAILBOXES: RefCell<(u64, Vec<Entry>)> = const { RefCell::new((0, Vec::new())) };
 }
 
-/// One ray's view of a structure's mailboxes.
+/// One ray's view of a structure's mailboxes. It holds the stamps themselves, so filtering a
+/// cell needs no thread-local lookup, and an eviction while the ray is under way cannot
+/// take them from it.
 pub struct Mailbox {
-    owner: u64,
     ray: u32,
-    /// Where the stamps were when the ray started: checked, then used without a search.
-    slot: std::cell::Cell<usize>,
+    stamps: Rc<RefCell<Stamps>>,
 }
 
 impl Mailbox {
-    /// Starts a ray through the structure `owner` holding `items` items.
+    /// A new ray through the structure `owner` of `items` items: a fresh stamp.
     pub fn start(owner: u64, items: usize) -> Mailbox {
         MAILBOXES.with(|m| {
             let (clock, boxes) = &mut *m.borrow_mut();
             *clock += 1;
-            let slot = match boxes.iter().position(|s| s.owner == owner) {
+            let slot = match boxes.iter().position(|e| e.owner == owner) {
                 Some(i) => i,
                 None => {
                     if boxes.len() >= KEPT {
                         let oldest = (0..boxes.len()).min_by_key(|&i| boxes[i].used);
                         boxes.swap_remove(oldest.unwrap_or(0));
                     }
-                    boxes.push(Stamps {
+                    boxes.push(Entry {
                         owner,
-                        ray: 0,
-                        stamps: vec![0; items],
                         used: 0,
+                        stamps: Rc::new(RefCell::new(Stamps {
+                            ray: 0,
+                            stamps: vec![0; items],
+                        })),
                     });
                     boxes.len() - 1
                 }
             };
-            let s = &mut boxes[slot];
-            s.used = *clock;
-            s.ray = s.ray.wrapping_add(1);
-            if s.ray == 0 {
-                // After 2³² rays the numbers repeat: clear the stamps once.
-                s.stamps.fill(0);
-                s.ray = 1;
-            }
+            let entry = &mut boxes[slot];
+            entry.used = *clock;
+            let ray = {
+                let mut s = entry.stamps.borrow_mut();
+                s.ray = s.ray.wrapping_add(1);
+                if s.ray == 0 {
+                    s.stamps.fill(0);
+                    s.ray = 1;
+                }
+                s.ray
+            };
             Mailbox {
-                owner,
-                ray: s.ray,
-                slot: std::cell::Cell::new(slot),
+                ray,
+                stamps: entry.stamps.clone(),
             }
         })
     }
 
-    /// Hands `visit` the items of `cell` this ray has not tested yet (see
-    /// [`super::Accel::traverse`]); returns false if `visit` asked to stop.
+    /// Hands `visit` the items of `cell` this ray has not tested yet, in chunks, and stamps
+    /// them; false when `visit` asked to stop.
     pub fn visit_untested(
         &self,
         cell: &[u32],
@@ -98,43 +108,27 @@ impl Mailbox {
         true
     }
 
-    /// Copies to `out` the items of `cell` this ray has not tested yet, stamping them;
-    /// returns how many were copied and how many of `cell` were consumed.
-    fn filter(&self, cell: &[u32], out: &mut [u32]) -> (usize, usize) {
-        MAILBOXES.with(|m| {
-            let (clock, boxes) = &mut *m.borrow_mut();
-            *clock += 1;
-            let ours = |s: &Stamps| s.owner == self.owner && s.ray == self.ray;
-            let slot = match boxes.get(self.slot.get()) {
-                Some(s) if ours(s) => Some(self.slot.get()),
-                _ => boxes.iter().position(ours),
-            };
-            let Some(s) = slot.map(|i| {
-                self.slot.set(i);
-                &mut boxes[i]
-            }) else {
-                // Our stamps were evicted by traversals nested in this one (more than
-                // `KEPT` structures in between): test everything rather than skip an item.
-                let n = cell.len().min(out.len());
-                out[..n].copy_from_slice(&cell[..n]);
-                return (n, n);
-            };
-            s.used = *clock;
-            let mut copied = 0;
-            let mut consumed = 0;
-            for &item in cell {
-                if copied == out.len() {
-                    break;
-                }
-                consumed += 1;
-                let stamp = &mut s.stamps[item as usize];
-                if *stamp != self.ray {
-                    *stamp = self.ray;
-                    out[copied] = item;
-                    copied += 1;
-                }
+    /// Copies untested items of `cell` into `out` (as many as fit) and stamps them; returns
+    /// how many were copied and how many of `cell` were looked at. The stamps are borrowed
+    /// only here, never while `visit` runs, so a nested traversal of the same structure
+    /// (another ray, with its own stamp) does not conflict; at worst it makes this ray test
+    /// an item again.
+    fn filter(&self, cell: &[u32], out: &mut [u32; CHUNK]) -> (usize, usize) {
+        let mut s = self.stamps.borrow_mut();
+        let mut copied = 0;
+        let mut consumed = 0;
+        for &item in cell {
+            if copied == CHUNK {
+                break;
             }
-            (copied, consumed)
-        })
+            consumed += 1;
+            let stamp = &mut s.stamps[item as usize];
+            if *stamp != self.ray {
+                *stamp = self.ray;
+                out[copied] = item;
+                copied += 1;
+            }
+        }
+        (copied, consumed)
     }
 }
