@@ -84,7 +84,8 @@ struct ViewArgs {
     #[arg(long, default_value_t = 3)]
     adaptive_depth: u32,
     /// Adaptive sampling by variance: stop a pixel when the standard error of its luminance
-    /// is below this fraction of its mean (of 0.05 in dark pixels).
+    /// is below this fraction of its mean (of 0.05 in dark pixels), or at --spp samples
+    /// (default: 16 × --min-spp, or the file's spp if larger).
     #[arg(long)]
     noise_threshold: Option<f64>,
     /// Adaptive sampling by variance: samples per pixel before the first check, and per batch.
@@ -282,14 +283,19 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
                 eprintln!("error: --noise-threshold must be a positive number");
                 return Err(ExitCode::from(2));
             }
-            if view.min_spp < 2 || view.min_spp > spp {
-                eprintln!("error: --min-spp must be between 2 and --spp ({spp})");
+            // The budget is --spp; without one, at least 16 batches whatever the file says.
+            let max_spp = match view.spp {
+                Some(n) => n,
+                None => spp.max(16 * view.min_spp).min(MAX_SPP),
+            };
+            if view.min_spp < 2 || view.min_spp > max_spp {
+                eprintln!("error: --min-spp must be between 2 and --spp ({max_spp})");
                 return Err(ExitCode::from(2));
             }
             Some(Adaptive::Variance {
                 threshold,
                 min_spp: view.min_spp,
-                max_spp: spp,
+                max_spp,
             })
         }
         (SamplerArg::Adaptive, None) => {

@@ -138,13 +138,19 @@ pub fn render(
                 let (y0, y1) = (y.saturating_sub(1), (y + 1).min(h - 1));
                 (y0..=y1).any(|j| (x0..=x1).any(|i| open[(j * w + i) as usize]))
             };
-            let (colors, rest) = tiles.run(1, &mut counts, |x, y, c| {
+            let (refined, rest) = tiles.run(1, &mut counts, |x, y, c| {
                 let mut e = first[(y * w + x) as usize].clone();
                 if done && near_open(x, y) {
                     refine_pixel(&whitted, &camera, settings, (x, y), &mut e, c, None);
                 }
-                e.value()
+                Some(e.value())
             });
+            // Tiles a cancel kept from the second pass keep what the first one found.
+            let colors = refined
+                .iter()
+                .zip(&first)
+                .map(|(r, f)| r.unwrap_or_else(|| f.value()))
+                .collect();
             (colors, done && rest)
         }
         _ => tiles.run(0, &mut counts, |x, y, c| {
@@ -185,7 +191,8 @@ struct Tiles<'a> {
 
 impl Tiles<'_> {
     /// Computes `pixel(x, y, counts)` for every pixel, tiles in parallel; returns the values
-    /// row by row and whether every tile was done (cancelled tiles get `T::default()`).
+    /// row by row and whether every tile was done (tiles skipped after a cancel keep
+    /// `T::default()`).
     fn run<T: Clone + Default + Send>(
         &self,
         pass: usize,
