@@ -117,7 +117,7 @@ impl Octree {
         }
         // Items that mostly straddle the centre: splitting would only copy them.
         let copies: usize = children.iter().map(Vec::len).sum();
-        if copies > 4 * items.len() || children.iter().all(|c| c.len() == items.len()) {
+        if copies > 2 * items.len() || children.iter().all(|c| c.len() == items.len()) {
             return make_leaf(self, &items);
         }
         let first = self.nodes.len();
@@ -212,7 +212,14 @@ impl Octree {
                     n += 1;
                 }
             }
-            crossings[..n].sort_by(|x, y| x.0.total_cmp(&y.0));
+            // At most three: sorted by exchanges, without a call into the general sort.
+            for i in 1..n {
+                let mut j = i;
+                while j > 0 && crossings[j].0 < crossings[j - 1].0 {
+                    crossings.swap(j, j - 1);
+                    j -= 1;
+                }
+            }
             // Children along the ray: push them farthest first so the nearest pops next.
             let mut sequence = [(0usize, 0.0f64, 0.0f64); 4];
             let mut t = ta;
@@ -223,6 +230,11 @@ impl Octree {
             }
             sequence[n] = (octant, t, tb);
             for &(oct, t0, t1) in sequence[..=n].iter().rev() {
+                let child = &self.nodes[(node.first_child + oct as u32) as usize];
+                if child.first_child == 0 && child.count == 0 {
+                    // An empty leaf: nothing to visit there.
+                    continue;
+                }
                 let (clo, chi) = child_box(lo, hi, oct);
                 stack[top].write((node.first_child + oct as u32, clo, chi, t0, t1));
                 top += 1;
