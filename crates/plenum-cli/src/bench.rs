@@ -21,9 +21,10 @@ pub struct BenchArgs {
     /// A rays file (PLRAYS1, see ../shared/bench/README.md).
     #[arg(long)]
     rays: PathBuf,
-    /// Acceleration structure: bvh, grid, octree or none.
+    /// Acceleration structure: bvh, grid, octree or none; embree (Intel Embree 3, for
+    /// reference) when built with `--features embree`.
     #[arg(long, default_value = "bvh")]
-    accel: AccelKind,
+    accel: BenchAccel,
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
@@ -38,10 +39,43 @@ pub struct BenchArgs {
     json: bool,
 }
 
+/// What `--accel` names: one of Plenum's structures, or Embree.
+#[derive(Clone, Copy, Debug)]
+pub enum BenchAccel {
+    Plenum(AccelKind),
+    Embree,
+}
+
+impl std::str::FromStr for BenchAccel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "embree" if cfg!(feature = "embree") => Ok(BenchAccel::Embree),
+            "embree" => Err(
+                "this plenum was built without Embree: build it with `--features embree` \
+                 (after `apt-get install libembree-dev`)"
+                    .into(),
+            ),
+            _ => s.parse().map(BenchAccel::Plenum),
+        }
+    }
+}
+
+impl BenchAccel {
+    fn name(self) -> &'static str {
+        match self {
+            BenchAccel::Plenum(kind) => kind.name(),
+            BenchAccel::Embree => "embree",
+        }
+    }
+}
+
 /// What is traced: a mesh's triangles (hits name triangles) or a scene (hits name primitives).
 enum Target {
     Mesh(Box<TriangleMesh>),
     Scene(Box<Scene>),
+    #[cfg(feature = "embree")]
+    Embree(Box<crate::embree::EmbreeMesh>),
 }
 
 impl Target {
@@ -49,6 +83,8 @@ impl Target {
         match self {
             Target::Mesh(m) => m.intersect(ray, t_max).map(|h| (h.t, h.part)),
             Target::Scene(s) => s.intersect(ray, t_max).map(|(p, h)| (h.t, p)),
+            #[cfg(feature = "embree")]
+            Target::Embree(e) => e.closest(ray, t_max),
         }
     }
 
@@ -56,6 +92,8 @@ impl Target {
         match self {
             Target::Mesh(m) => m.intersect_any(ray, t_max).is_some(),
             Target::Scene(s) => s.occluded(ray, t_max),
+            #[cfg(feature = "embree")]
+            Target::Embree(e) => e.occluded(ray, t_max),
         }
     }
 
@@ -63,6 +101,8 @@ impl Target {
         match self {
             Target::Mesh(m) => m.triangle_count(),
             Target::Scene(s) => s.primitives.len(),
+            #[cfg(feature = "embree")]
+            Target::Embree(e) => e.triangle_count(),
         }
     }
 
@@ -70,6 +110,9 @@ impl Target {
         match self {
             Target::Mesh(m) => m.memory_bytes(),
             Target::Scene(s) => s.accel_memory_bytes(),
+            // Embree does not say.
+            #[cfg(feature = "embree")]
+            Target::Embree(_) => 0,
         }
     }
 }
@@ -123,15 +166,19 @@ pub fn run(args: BenchArgs) -> ExitCode {
     // Load, then time the build of the chosen structure alone.
     let (target, build_seconds) = pool
         .install(|| {
+            let kind = match args.accel {
+                BenchAccel::Plenum(kind) => kind,
+                BenchAccel::Embree => return embree_target(&args.mesh, is_mesh),
+            };
             if is_mesh {
                 let mut mesh = plenum_scene::load_mesh(&args.mesh)?;
                 let start = Instant::now();
-                mesh.set_accel(args.accel);
+                mesh.set_accel(kind);
                 Ok((Target::Mesh(Box::new(mesh)), start.elapsed().as_secs_f64()))
             } else {
                 let scene = plenum_scene::load_scene(&args.mesh)?.scene;
                 let start = Instant::now();
-                let scene = scene.with_accel(args.accel);
+                let scene = scene.with_accel(kind);
                 Ok((
                     Target::Scene(Box::new(scene)),
                     start.elapsed().as_secs_f64(),
@@ -211,6 +258,31 @@ pub fn run(args: BenchArgs) -> ExitCode {
         report.print(&args.rays, args.passes);
     }
     ExitCode::SUCCESS
+}
+
+/// Embree's structure over a mesh file's triangles, and its build time.
+#[cfg(feature = "embree")]
+fn embree_target(path: &Path, is_mesh: bool) -> Result<(Target, f64), plenum_scene::SceneError> {
+    if !is_mesh {
+        eprintln!("error: --accel embree takes a mesh file (.obj or .ply)");
+        std::process::exit(2);
+    }
+    let mesh = plenum_scene::load_mesh(path)?;
+    let threads = rayon::current_num_threads();
+    let start = Instant::now();
+    let embree = crate::embree::EmbreeMesh::build(&mesh, threads).unwrap_or_else(|e| {
+        eprintln!("error: {e}");
+        std::process::exit(1)
+    });
+    Ok((
+        Target::Embree(Box::new(embree)),
+        start.elapsed().as_secs_f64(),
+    ))
+}
+
+#[cfg(not(feature = "embree"))]
+fn embree_target(_: &Path, _: bool) -> Result<(Target, f64), plenum_scene::SceneError> {
+    unreachable!("`embree` does not parse without the feature")
 }
 
 fn extension(path: &Path) -> String {

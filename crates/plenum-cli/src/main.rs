@@ -4,6 +4,8 @@
 //! a bad argument); 130 interrupted by Ctrl-C, after writing what was rendered.
 
 mod bench;
+#[cfg(feature = "embree")]
+mod embree;
 mod trace;
 
 use clap::{Args, Parser, Subcommand};
