@@ -127,7 +127,7 @@ impl Emitter {
         }
     }
 
-    /// A point seen from `p`, its unit normal, and the pdf of choosing it with respect to
+    /// A point of the surface for `p` to aim at, and the pdf of choosing it with respect to
     /// solid angle at `p` (the area pdf converted by d² / |cos θ_light|); `None` if the
     /// sample sees the surface edge-on.
     fn sample(&self, p: Vec3, u: [f64; 2]) -> Option<(Vec3, f64)> {

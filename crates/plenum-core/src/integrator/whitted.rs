@@ -151,7 +151,10 @@ impl<'a> Whitted<'a> {
 
         // Local illumination: emission, ambient, and Phong from every light.
         let mut color = k.emissive + k.ambient * self.scene.ambient;
-        for (li, light) in self.scene.lights.iter().enumerate() {
+        // A surface that neither diffuses nor highlights (an emitter, a mirror, clear
+        // glass) needs no shadow rays.
+        let lit = !(k.diffuse.is_black() && k.specular.is_black());
+        for (li, light) in self.scene.lights.iter().enumerate().filter(|_| lit) {
             // An area light's m × m shadow rays share one offset from the stream, each in
             // its own cell: stratified within the shading point, and the offset stratified
             // across the pixel's samples.
