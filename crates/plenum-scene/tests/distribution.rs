@@ -312,3 +312,41 @@ fn moving_edge_blurs_into_a_linear_ramp() {
         assert!((value - expected).abs() < 0.02, "half shutter, column {x}");
     }
 }
+
+/// Every acceleration structure bounds moving objects over their whole path: a still frame
+/// late in the motion (shutter [0.9, 0.9]) renders exactly as the same scene with each moving
+/// object placed statically at its pose of time 0.9. A structure that bounded only the pose
+/// at time 0 would lose the ball, which has moved out of its first box by then.
+#[test]
+fn every_structure_bounds_moving_objects() {
+    use plenum_core::accel::AccelKind;
+    let loaded = plenum_scene::load_scene(Path::new("../../scenes/motion-blur.toml"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let settings = RenderSettings {
+        width: 48,
+        height: 32,
+        seed: 2,
+        ..Default::default()
+    };
+    let draw = |scene: &Scene| {
+        render(scene, &settings, &AtomicBool::new(false), &|_, _| {})
+            .film
+            .pixels()
+            .to_vec()
+    };
+    let mut moving = loaded.scene.clone();
+    moving.camera.shutter = [0.9, 0.9];
+    let mut posed = moving.clone();
+    for p in &mut posed.primitives {
+        if let Some(m) = p.motion.take() {
+            p.to_world = Some(Box::new(m.at(0.9)));
+        }
+    }
+    for kind in AccelKind::ALL {
+        let (a, b) = (
+            draw(&moving.clone().with_accel(kind)),
+            draw(&posed.clone().with_accel(kind)),
+        );
+        assert!(a == b, "{}", kind.name());
+    }
+}
