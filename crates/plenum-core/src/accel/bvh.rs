@@ -1,6 +1,7 @@
-//! A four-wide bounding-volume hierarchy: a binned surface-area-heuristic build (Wald 2007)
+//! An eight-wide bounding-volume hierarchy: a binned surface-area-heuristic build (Wald 2007)
 //! over all three axes, parallel across subtrees, whose binary splits are collapsed so each
-//! node holds four children; compact f32 nodes tested four boxes at a time with SSE; ordered
+//! node holds eight children; compact f32 nodes tested eight boxes at a time with AVX where
+//! the CPU has it (detected at run time) and as two four-box SSE tests otherwise; ordered
 //! front-to-back traversal with a fixed-size stack (no allocation per ray).
 //!
 //! The BVH knows only boxes. Its leaves are runs of item indices handed to the caller's
@@ -18,9 +19,11 @@ use crate::math::{Bounds3, Ray};
 use std::mem::MaybeUninit;
 
 const BINS: usize = 16;
+/// Children per node.
+const WIDTH: usize = 8;
 /// Deepest binary split; bounds the traversal stack (three entries per level at most).
 const MAX_DEPTH: usize = 64;
-const STACK: usize = 3 * MAX_DEPTH + 4;
+const STACK: usize = 7 * MAX_DEPTH + 8;
 /// Cost of visiting a node relative to testing one leaf block.
 const TRAVERSAL_COST: f32 = 1.0;
 /// Subtrees with more items than this are built in parallel.
@@ -34,13 +37,13 @@ const START_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 const MAX_LEAF_ITEMS: usize = 15;
 const EMPTY: u32 = LEAF_BIT;
 
-/// Four child boxes as six planes of four lanes: min x, y, z then max x, y, z. Two cache
+/// Eight child boxes as six planes of eight lanes: min x, y, z then max x, y, z. Four cache
 /// lines exactly.
 #[derive(Clone, Debug)]
 #[repr(C, align(64))]
 struct Node {
-    planes: [[f32; 4]; 6],
-    children: [u32; 4],
+    planes: [[f32; WIDTH]; 6],
+    children: [u32; WIDTH],
     /// Bit i set where child slot i is used.
     used: u32,
 }
@@ -176,19 +179,19 @@ impl Bvh {
         self.nodes.len() * std::mem::size_of::<Node>() + self.order.len() * 4
     }
 
-    /// Appends a node holding `children` (at most four), then their subtrees depth-first.
+    /// Appends a node holding `children` (at most eight), then their subtrees depth-first.
     fn flatten_children(&mut self, children: &[BuildNode]) -> u32 {
         let index = self.nodes.len();
         let mut node = Node {
             planes: [
-                [f32::INFINITY; 4],
-                [f32::INFINITY; 4],
-                [f32::INFINITY; 4],
-                [f32::NEG_INFINITY; 4],
-                [f32::NEG_INFINITY; 4],
-                [f32::NEG_INFINITY; 4],
+                [f32::INFINITY; WIDTH],
+                [f32::INFINITY; WIDTH],
+                [f32::INFINITY; WIDTH],
+                [f32::NEG_INFINITY; WIDTH],
+                [f32::NEG_INFINITY; WIDTH],
+                [f32::NEG_INFINITY; WIDTH],
             ],
-            children: [EMPTY; 4],
+            children: [EMPTY; WIDTH],
             used: (1 << children.len()) - 1,
         };
         for (slot, child) in children.iter().enumerate() {
@@ -231,13 +234,49 @@ impl Bvh {
     /// whose box the ray crosses in (0, t_max); it may shrink `t_max` to prune farther boxes,
     /// and returns false to stop.
     #[inline]
-    pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
+    pub fn traverse(&self, ray: &Ray, t_max: f64, visit: impl FnMut(&[u32], &mut f64) -> bool) {
         if self.nodes.is_empty() {
             return;
         }
         let r = BoxRay::new(ray);
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx") {
+            // SAFETY: the CPU has AVX.
+            return unsafe { self.traverse_avx(&r, t_max, visit) };
+        }
+        self.traverse_with(t_max, visit, |planes, far| r.test8(planes, F4::splat(far)));
+    }
+
+    /// The traversal with eight boxes tested per AVX instruction.
+    ///
+    /// # Safety
+    /// The CPU must support AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn traverse_avx(
+        &self,
+        r: &BoxRay,
+        t_max: f64,
+        visit: impl FnMut(&[u32], &mut f64) -> bool,
+    ) {
+        // SAFETY: this function runs only where the CPU has AVX.
+        let wide = unsafe { r.avx() };
+        self.traverse_with(t_max, visit, |planes, far| unsafe {
+            wide.test8(planes, far)
+        });
+    }
+
+    /// The traversal, with `test(planes, far)` giving a node's eight entry distances and
+    /// the mask of the children the ray crosses before `far`.
+    #[inline(always)]
+    fn traverse_with(
+        &self,
+        t_max: f64,
+        mut visit: impl FnMut(&[u32], &mut f64) -> bool,
+        test: impl Fn(&[[f32; WIDTH]; 6], f32) -> ([f32; WIDTH], u32),
+    ) {
         let mut t_max = t_max;
-        let mut far = F4::splat(round_up(t_max));
+        let mut far = round_up(t_max);
         // Uninitialised: only entries below `top`, all written first, are read.
         let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK];
         let mut top = 0usize;
@@ -249,13 +288,12 @@ impl Bvh {
                 if !visit(&self.order[start..start + count], &mut t_max) {
                     return;
                 }
-                far = F4::splat(round_up(t_max));
+                far = round_up(t_max);
             } else {
                 let node = &self.nodes[current as usize];
-                let (near, hits) = r.test4(&node.planes, far);
+                let (near, hits) = test(&node.planes, far);
                 let mut hits = hits & node.used;
                 if hits != 0 {
-                    let near = near.to_array();
                     // The nearest hit child is visited next; the others wait on the stack,
                     // nearest on top.
                     let first = hits.trailing_zeros() as usize;
@@ -289,7 +327,7 @@ impl Bvh {
                 }
             }
             // Pop the nearest waiting child still in reach.
-            let limit = far.to_array()[0];
+            let limit = far;
             loop {
                 if top == 0 {
                     return;
@@ -323,12 +361,12 @@ impl Builder {
                 count: items.len() as u32,
             };
         };
-        // Split the larger parts again until there are four children (or nothing splits).
+        // Split the larger parts again until there are eight children (or nothing splits).
         let mut parts: Vec<(usize, usize, Aabb, bool)> = vec![
             (0, mid, Aabb::of(&items[..mid]), true),
             (mid, items.len(), Aabb::of(&items[mid..]), true),
         ];
-        while parts.len() < 4 {
+        while parts.len() < WIDTH {
             let Some(k) = (0..parts.len())
                 .filter(|&k| parts[k].3 && parts[k].1 - parts[k].0 > 1)
                 .max_by(|&a, &b| parts[a].2.half_area().total_cmp(&parts[b].2.half_area()))
