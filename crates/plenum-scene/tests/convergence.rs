@@ -17,6 +17,11 @@ const SAMPLERS: [SamplerKind; 5] = [
     SamplerKind::Sobol,
 ];
 
+/// A scene from native-format text.
+fn scene(text: &str) -> LoadedScene {
+    parse_scene(Path::new("test.toml"), text, Path::new(".")).unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// Luminance per pixel, and the camera rays spent.
 fn draw(loaded: &LoadedScene, settings: &RenderSettings) -> (Vec<f64>, u64) {
     let out = render(&loaded.scene, settings, &AtomicBool::new(false), &|_, _| {});
@@ -124,8 +129,7 @@ fn checkerboard_to_the_horizon() {
 /// Sobol's faster (ratio above 2.5).
 #[test]
 fn smooth_penumbra_converges_faster_when_stratified() {
-    let loaded = parse_scene(
-        Path::new("smooth.toml"),
+    let loaded = scene(
         r#"
 [camera]
 position = [0, 3, 0.01]
@@ -156,9 +160,7 @@ center = [1.2, 3.5, 0]
 normal = [0, 1, 0]
 radius = 0.8
 "#,
-        Path::new("."),
-    )
-    .unwrap();
+    );
     let size = (32, 32);
     let (reference, _) = draw(
         &loaded,
@@ -192,8 +194,7 @@ radius = 0.8
 /// half its samples (camera rays counted).
 #[test]
 fn adaptive_sampling_spends_samples_on_edges() {
-    let loaded = parse_scene(
-        Path::new("flat.toml"),
+    let loaded = scene(
         r#"
 [camera]
 position = [0, 0, 8]
@@ -222,9 +223,7 @@ type = "polygon"
 material = "blue"
 vertices = [[0.2, -2, -1], [2.6, -1.5, -1], [1.8, 1.9, -1]]
 "#,
-        Path::new("."),
-    )
-    .unwrap();
+    );
     let (w, h) = (64, 48);
     let (reference, _) = draw(
         &loaded,
