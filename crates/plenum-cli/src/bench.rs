@@ -81,7 +81,10 @@ enum Target {
 impl Target {
     fn closest(&self, ray: &Ray, t_max: f64) -> Option<(f64, u32)> {
         match self {
-            Target::Mesh(m) => m.intersect(ray, t_max).map(|h| (h.t, h.part)),
+            // Hits name triangles as the mesh file does.
+            Target::Mesh(m) => m
+                .intersect(ray, t_max)
+                .map(|h| (h.t, m.source_triangle(h.part))),
             Target::Scene(s) => s.intersect(ray, t_max).map(|(p, h)| (h.t, p)),
             #[cfg(feature = "embree")]
             Target::Embree(e) => e.closest(ray, t_max),

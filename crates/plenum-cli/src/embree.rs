@@ -97,8 +97,8 @@ unsafe impl Send for EmbreeMesh {}
 unsafe impl Sync for EmbreeMesh {}
 
 impl EmbreeMesh {
-    /// Builds Embree's BVH over the mesh's triangles (in the mesh's order, so hits name the
-    /// same triangles), with `threads` build threads.
+    /// Builds Embree's BVH over the mesh's triangles, in the order the mesh was made from (so
+    /// hits name triangles as the mesh file does), with `threads` build threads.
     pub fn build(mesh: &TriangleMesh, threads: usize) -> Result<EmbreeMesh, String> {
         let config = CString::new(format!("threads={threads}")).map_err(|e| e.to_string())?;
         // SAFETY: plain calls into the Embree C API with the buffers it hands out, sized as
@@ -141,8 +141,9 @@ impl EmbreeMesh {
                 }
             }
             for (i, t) in triangles.iter().enumerate() {
+                let at = mesh.source_triangle(i as u32) as usize;
                 for (a, &v) in t.iter().enumerate() {
-                    *indices.add(3 * i + a) = v;
+                    *indices.add(3 * at + a) = v;
                 }
             }
             rtcCommitGeometry(geometry);
@@ -244,7 +245,9 @@ mod tests {
             let mut point = || centre + uniform_sphere([rng.uniform(), rng.uniform()]) * radius;
             let (from, to) = (point(), point());
             let ray = Ray::new(from, to - from);
-            let ours = mesh.intersect(&ray, 1.0).map(|h| (h.t, h.part));
+            let ours = mesh
+                .intersect(&ray, 1.0)
+                .map(|h| (h.t, mesh.source_triangle(h.part)));
             let theirs = embree.closest(&ray, 1.0);
             let same = match (ours, theirs) {
                 (None, None) => true,

@@ -6,7 +6,9 @@
 //!
 //! The BVH knows only boxes. Its leaves are runs of item indices handed to the caller's
 //! closure, so one structure serves the triangles of a mesh (tested four at once) and the
-//! primitives of a scene alike.
+//! primitives of a scene alike. A caller may instead store its items in the leaf order
+//! (as pbrt does with its primitives): leaves are then runs of consecutive items, with no
+//! index to read per item, which is how meshes use it.
 //!
 //! Boxes are rounded outward to f32, and the slab test is made conservative the way pbrt-v4
 //! (§6.8.2) does it: the far distance is enlarged by the relative error of its computation,
@@ -17,6 +19,7 @@ use super::ray_f32::{round_down, round_up, BoxRay};
 use super::simd::F4;
 use crate::math::{Bounds3, Ray};
 use std::mem::MaybeUninit;
+use std::ops::Range;
 
 const BINS: usize = 16;
 /// Children per node.
@@ -220,7 +223,7 @@ impl Bvh {
             if let Some(node) = self.nodes.get(child as usize) {
                 let p = node as *const Node as *const i8;
                 // SAFETY: prefetching is a hint; the address is that of a live node and the
-                // second line lies inside it (nodes are 128 bytes, aligned to 64).
+                // second line lies inside it (nodes are 256 bytes, aligned to 64).
                 unsafe {
                     use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
                     _mm_prefetch(p, _MM_HINT_T0);
@@ -234,7 +237,26 @@ impl Bvh {
     /// whose box the ray crosses in (0, t_max); it may shrink `t_max` to prune farther boxes,
     /// and returns false to stop.
     #[inline]
-    pub fn traverse(&self, ray: &Ray, t_max: f64, visit: impl FnMut(&[u32], &mut f64) -> bool) {
+    pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
+        self.traverse_runs(ray, t_max, |run, t_max| visit(&self.order[run], t_max));
+    }
+
+    /// Hands the caller the items in leaf order and leaves the BVH without them: for a caller
+    /// that stores its items in this order, so that leaves name runs of them directly
+    /// ([`Bvh::traverse_runs`]) and no index is read per item. [`Bvh::traverse`] must not be
+    /// used afterwards.
+    pub fn take_order(&mut self) -> Vec<u32> {
+        std::mem::take(&mut self.order)
+    }
+
+    /// [`Bvh::traverse`] handing each leaf as its run of positions in the leaf order.
+    #[inline]
+    pub fn traverse_runs(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        visit: impl FnMut(Range<usize>, &mut f64) -> bool,
+    ) {
         if self.nodes.is_empty() {
             return;
         }
@@ -257,7 +279,7 @@ impl Bvh {
         &self,
         r: &BoxRay,
         t_max: f64,
-        visit: impl FnMut(&[u32], &mut f64) -> bool,
+        visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
         // SAFETY: this function runs only where the CPU has AVX.
         let wide = unsafe { r.avx() };
@@ -272,7 +294,7 @@ impl Bvh {
     fn traverse_with(
         &self,
         t_max: f64,
-        mut visit: impl FnMut(&[u32], &mut f64) -> bool,
+        mut visit: impl FnMut(Range<usize>, &mut f64) -> bool,
         test: impl Fn(&[[f32; WIDTH]; 6], f32) -> ([f32; WIDTH], u32),
     ) {
         let mut t_max = t_max;
@@ -285,7 +307,7 @@ impl Bvh {
             if current & LEAF_BIT != 0 {
                 let start = (current & START_MASK) as usize;
                 let count = ((current & !LEAF_BIT) >> COUNT_SHIFT) as usize;
-                if !visit(&self.order[start..start + count], &mut t_max) {
+                if !visit(start..start + count, &mut t_max) {
                     return;
                 }
                 far = round_up(t_max);

@@ -34,44 +34,43 @@ pub fn round_up(x: f64) -> f32 {
     }
 }
 
-/// A ray prepared for slab tests against four boxes at once.
+/// A ray prepared for slab tests against four or eight boxes at once.
 pub struct BoxRay {
     /// The origin rounded up, for the distances to min planes, and down, for max planes:
     /// whichever of the two is the entry, it is never overestimated, and the exit never
     /// underestimated, whatever the direction's sign.
-    origin_up: [F4; 3],
-    origin_down: [F4; 3],
-    inv_dir: [F4; 3],
+    origin_up: [f32; 3],
+    origin_down: [f32; 3],
+    inv_dir: [f32; 3],
 }
 
-/// Relative enlargement of exit distances: the subtraction, the multiplication and the
-/// rounding of the reciprocal direction, with margin.
+/// Relative enlargement of exit distances: the subtraction, the multiplication and the two
+/// roundings of the reciprocal direction, with margin.
 const FAR_SCALE: f32 = 1.0 + 2.0 * gamma_f32(5);
 
 impl BoxRay {
+    /// Per ray, so kept to one vector division and no branches.
+    #[inline]
     pub fn new(ray: &Ray) -> BoxRay {
-        let axis = |a: usize| {
-            // A zero component would make 0·∞ = NaN at a plane through the origin; a tiny
-            // one gives the same answer without it.
-            let d = ray.direction[a];
-            let d = if d.abs() < 1e-30 {
-                1e-30f64.copysign(d)
-            } else {
-                d
-            };
-            // One ulp either side brackets the f64 origin without comparing.
-            let o = ray.origin[a] as f32;
-            (
-                F4::splat(o.next_up()),
-                F4::splat(o.next_down()),
-                F4::splat((1.0 / d) as f32),
-            )
+        let (o, d) = (ray.origin, ray.direction);
+        // A zero component would make 0·∞ = NaN at a plane through the origin; a tiny one
+        // gives the same answer without it.
+        let away = |x: f64| x.abs().max(1e-30).copysign(x) as f32;
+        let inv = F4::splat(1.0).div(F4::from_array([away(d.x), away(d.y), away(d.z), 1.0]));
+        // The f32 origin moved by at least one ulp either way brackets the f64 one.
+        let o = F4::from_array([o.x as f32, o.y as f32, o.z as f32, 0.0]);
+        let ulp = o
+            .abs()
+            .mul(F4::splat(f32::EPSILON))
+            .add(F4::splat(f32::MIN_POSITIVE));
+        let xyz = |v: F4| {
+            let [x, y, z, _] = v.to_array();
+            [x, y, z]
         };
-        let (x, y, z) = (axis(0), axis(1), axis(2));
         BoxRay {
-            origin_up: [x.0, y.0, z.0],
-            origin_down: [x.1, y.1, z.1],
-            inv_dir: [x.2, y.2, z.2],
+            origin_up: xyz(o.add(ulp)),
+            origin_down: xyz(o.sub(ulp)),
+            inv_dir: xyz(inv),
         }
     }
 
@@ -79,12 +78,13 @@ impl BoxRay {
     #[inline(always)]
     pub fn test4(&self, planes: &[[f32; 4]; 6], far: F4) -> (F4, u32) {
         let slab = |a: usize| {
+            let inv = F4::splat(self.inv_dir[a]);
             let t0 = F4::load(&planes[a])
-                .sub(self.origin_up[a])
-                .mul(self.inv_dir[a]);
+                .sub(F4::splat(self.origin_up[a]))
+                .mul(inv);
             let t1 = F4::load(&planes[3 + a])
-                .sub(self.origin_down[a])
-                .mul(self.inv_dir[a]);
+                .sub(F4::splat(self.origin_down[a]))
+                .mul(inv);
             (t0.min(t1), t0.max(t1))
         };
         let (x0, x1) = slab(0);
@@ -124,7 +124,13 @@ impl BoxRay {
     #[inline]
     pub unsafe fn avx(&self) -> BoxRayAvx {
         use std::arch::x86_64::_mm256_set1_ps;
-        let wide = |v: &[F4; 3]| v.map(|x| _mm256_set1_ps(x.to_array()[0]));
+        let wide = |v: &[f32; 3]| {
+            [
+                _mm256_set1_ps(v[0]),
+                _mm256_set1_ps(v[1]),
+                _mm256_set1_ps(v[2]),
+            ]
+        };
         BoxRayAvx {
             origin_up: wide(&self.origin_up),
             origin_down: wide(&self.origin_down),

@@ -2,7 +2,8 @@
 //! ray–triangle test of Woop, Benthin and Wald (JCGT 2013): no ray slips through a shared
 //! edge or vertex. Vertices are stored in f32, like Embree and pbrt, and four triangles are
 //! tested at once in f32 SIMD; the rare hit exactly on an edge is settled in f64. Error
-//! bounds follow pbrt-v4 §6.8.4.
+//! bounds follow pbrt-v4 §6.8.4. With a BVH the triangles are kept in its leaf order, so a
+//! leaf's triangles lie side by side in memory.
 
 use super::{HitRecord, SurfaceGeometry};
 use crate::accel::ray_f32::{gamma_f32, round_up};
@@ -26,7 +27,10 @@ pub struct TriangleMesh {
     normals: Vec<Vec3>,
     /// Per-vertex texture coordinates, or empty.
     uvs: Vec<[f64; 2]>,
+    /// Stored in the BVH's leaf order, so a leaf is a run of consecutive triangles.
     triangles: Vec<[u32; 3]>,
+    /// The position of each stored triangle in the list the mesh was made from.
+    source: Vec<u32>,
     accel: Accel,
     bounds: Bounds3,
     /// Every edge joins exactly two triangles: the mesh bounds a solid.
@@ -121,11 +125,12 @@ impl TriangleMesh {
             packed,
             normals,
             uvs,
+            source: (0..triangles.len() as u32).collect(),
             triangles,
             accel: Accel::default(),
             closed,
         };
-        mesh.accel = Accel::build(AccelKind::Bvh, &mesh.triangle_bounds(), LEAF);
+        mesh.set_accel(AccelKind::Bvh);
         Ok(mesh)
     }
 
@@ -136,9 +141,21 @@ impl TriangleMesh {
         mesh
     }
 
-    /// Rebuilds the triangles' structure as a `kind` one.
+    /// Rebuilds the triangles' structure as a `kind` one. A BVH reorders the triangles to
+    /// its leaf order (see [`TriangleMesh::source_triangle`]).
     pub fn set_accel(&mut self, kind: AccelKind) {
         self.accel = Accel::build(kind, &self.triangle_bounds(), LEAF);
+        if let Accel::Bvh(bvh) = &mut self.accel {
+            let mut order = bvh.take_order();
+            // Every triangle has a box, so every one is in the order; but keep any left out.
+            if order.len() < self.triangles.len() {
+                let mut listed = vec![false; self.triangles.len()];
+                order.iter().for_each(|&i| listed[i as usize] = true);
+                order.extend((0..self.triangles.len() as u32).filter(|&i| !listed[i as usize]));
+            }
+            self.triangles = order.iter().map(|&i| self.triangles[i as usize]).collect();
+            self.source = order.iter().map(|&i| self.source[i as usize]).collect();
+        }
     }
 
     fn clone_without_accel(&self) -> TriangleMesh {
@@ -148,6 +165,7 @@ impl TriangleMesh {
             normals: self.normals.clone(),
             uvs: self.uvs.clone(),
             triangles: self.triangles.clone(),
+            source: self.source.clone(),
             accel: Accel::default(),
             bounds: self.bounds,
             closed: self.closed,
@@ -161,10 +179,6 @@ impl TriangleMesh {
             .collect()
     }
 
-    pub fn accel(&self) -> &Accel {
-        &self.accel
-    }
-
     /// Bytes the mesh occupies: vertices, indices, attributes and the acceleration structure.
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of::<TriangleMesh>()
@@ -173,6 +187,7 @@ impl TriangleMesh {
             + self.normals.len() * std::mem::size_of::<Vec3>()
             + self.uvs.len() * std::mem::size_of::<[f64; 2]>()
             + self.triangles.len() * std::mem::size_of::<[u32; 3]>()
+            + self.source.len() * std::mem::size_of::<u32>()
             + self.accel.memory_bytes()
     }
 
@@ -202,8 +217,15 @@ impl TriangleMesh {
         &self.uvs
     }
 
+    /// The triangles, in the order the mesh stores them (a BVH's leaf order), which is the
+    /// order hits name them in ([`HitRecord::part`]).
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.triangles
+    }
+
+    /// Where stored triangle `part` was in the list the mesh was made from.
+    pub fn source_triangle(&self, part: u32) -> u32 {
+        self.source[part as usize]
     }
 
     pub fn bounds(&self) -> Bounds3 {
@@ -218,12 +240,10 @@ impl TriangleMesh {
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
         let sheared = ShearedRay::new(ray);
         let mut best = None;
-        self.accel.traverse(ray, t_max, |items, t_max| {
-            for block in items.chunks(4) {
-                if let Some(hit) = self.intersect_block(&sheared, ray, block, *t_max) {
-                    *t_max = hit.t;
-                    best = Some(hit);
-                }
+        self.visit_blocks(ray, t_max, |corners, ids, count, t_max| {
+            if let Some(hit) = self.intersect_block(&sheared, ray, corners, ids, count, *t_max) {
+                *t_max = hit.t;
+                best = Some(hit);
             }
             true
         });
@@ -234,29 +254,83 @@ impl TriangleMesh {
     pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
         let sheared = ShearedRay::new(ray);
         let mut found = None;
-        self.accel.traverse(ray, t_max, |items, t_max| {
-            found = items
-                .chunks(4)
-                .find_map(|block| self.intersect_block(&sheared, ray, block, *t_max));
+        self.visit_blocks(ray, t_max, |corners, ids, count, t_max| {
+            found = self.intersect_block(&sheared, ray, corners, ids, count, *t_max);
             found.is_none()
         });
         found
     }
 
-    /// The nearest hit among up to four triangles, tested together.
+    /// Hands `test(corners, ids, count, t_max)` blocks of up to four triangles the ray may
+    /// meet, roughly nearest first, until it returns false. Lanes past `count` repeat the last
+    /// triangle.
+    #[inline(always)]
+    fn visit_blocks(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        mut test: impl FnMut(&[[F4; 3]; 3], [u32; 4], usize, &mut f64) -> bool,
+    ) {
+        if let Accel::Bvh(bvh) = &self.accel {
+            // Leaves are runs of the stored triangles: no index to read per triangle.
+            bvh.traverse_runs(ray, t_max, |run, t_max| {
+                let last = run.end as u32 - 1;
+                for base in run.step_by(4).map(|b| b as u32) {
+                    let ids = [0, 1, 2, 3].map(|lane| (base + lane).min(last));
+                    let count = (last - base + 1).min(4) as usize;
+                    if !test(&self.corners(ids), ids, count, t_max) {
+                        return false;
+                    }
+                }
+                true
+            });
+            return;
+        }
+        self.accel.traverse(ray, t_max, |items, t_max| {
+            for block in items.chunks(4) {
+                let last = block.len() - 1;
+                let ids = [0, 1, 2, 3].map(|lane| block[lane.min(last)]);
+                if !test(&self.corners(ids), ids, block.len(), t_max) {
+                    return false;
+                }
+            }
+            true
+        });
+    }
+
+    /// The corners of four triangles in lanes: `[corner][axis]`.
+    #[inline(always)]
+    fn corners(&self, ids: [u32; 4]) -> [[F4; 3]; 3] {
+        let tri = |lane: usize| self.triangles[ids[lane] as usize];
+        let (t0, t1, t2, t3) = (tri(0), tri(1), tri(2), tri(3));
+        let corner = |k: usize| {
+            let p = |t: [u32; 3]| {
+                // SAFETY: every index was checked against the vertex count in `new`.
+                F4::load(unsafe { self.packed.get_unchecked(t[k] as usize) })
+            };
+            let [x, y, z, _] = F4::transpose([p(t0), p(t1), p(t2), p(t3)]);
+            [x, y, z]
+        };
+        [corner(0), corner(1), corner(2)]
+    }
+
+    /// The nearest hit among up to four triangles, tested together: `corners[k][axis]` holds
+    /// corner k of each, `ids` their indices; lanes from `count` on are ignored.
     #[inline(always)]
     fn intersect_block(
         &self,
         r: &ShearedRay,
         ray: &Ray,
-        block: &[u32],
+        corners: &[[F4; 3]; 3],
+        block: [u32; 4],
+        count: usize,
         t_max: f64,
     ) -> Option<HitRecord> {
         // One copy of the test per axis the ray runs along, so the permutation is static.
         match r.axes[2] {
-            0 => self.intersect_block_along::<0>(r, ray, block, t_max),
-            1 => self.intersect_block_along::<1>(r, ray, block, t_max),
-            _ => self.intersect_block_along::<2>(r, ray, block, t_max),
+            0 => self.intersect_block_along::<0>(r, ray, corners, block, count, t_max),
+            1 => self.intersect_block_along::<1>(r, ray, corners, block, count, t_max),
+            _ => self.intersect_block_along::<2>(r, ray, corners, block, count, t_max),
         }
     }
 
@@ -265,18 +339,14 @@ impl TriangleMesh {
         &self,
         r: &ShearedRay,
         ray: &Ray,
-        block: &[u32],
+        corners: &[[F4; 3]; 3],
+        block: [u32; 4],
+        count: usize,
         t_max: f64,
     ) -> Option<HitRecord> {
         let (kx, ky) = ((KZ + 1) % 3, (KZ + 2) % 3);
-        // Gather the corners of four triangles (repeating the last for a short block) and
-        // turn them into lanes: one vector per coordinate of each corner.
-        let last = block.len() - 1;
-        let tri = |lane: usize| &self.triangles[block[lane.min(last)] as usize];
-        let (t0, t1, t2, t3) = (tri(0), tri(1), tri(2), tri(3));
         let corner = |k: usize| {
-            let p = |t: &[u32; 3]| F4::load(&self.packed[t[k] as usize]);
-            let p = F4::transpose([p(t0), p(t1), p(t2), p(t3)]);
+            let p = &corners[k];
             let x = p[kx].sub(r.origin[0]);
             let y = p[ky].sub(r.origin[1]);
             let z = p[KZ].sub(r.origin[2]);
@@ -284,7 +354,7 @@ impl TriangleMesh {
             [x.add(r.shear[0].mul(z)), y.add(r.shear[1].mul(z)), z]
         };
         let (a, b, c) = (corner(0), corner(1), corner(2));
-        let lanes = (1u32 << block.len()) - 1;
+        let lanes = (1u32 << count) - 1;
         let e0 = b[0].mul(c[1]).sub(b[1].mul(c[0]));
         let e1 = c[0].mul(a[1]).sub(c[1].mul(a[0]));
         let e2 = a[0].mul(b[1]).sub(a[1].mul(b[0]));
@@ -412,19 +482,20 @@ struct ShearedRay {
 }
 
 impl ShearedRay {
+    #[inline]
     fn new(ray: &Ray) -> ShearedRay {
         let kz = ray.direction.max_abs_axis();
         let kx = (kz + 1) % 3;
         let ky = (kx + 1) % 3;
         let d = [kx, ky, kz].map(|a| ray.direction[a] as f32);
+        // The three quotients in one division.
+        let [sx, sy, sz, _] = F4::from_array([-d[0], -d[1], 1.0, 1.0])
+            .div(F4::splat(d[2]))
+            .to_array();
         ShearedRay {
             axes: [kx, ky, kz],
             origin: [kx, ky, kz].map(|a| F4::splat(ray.origin[a] as f32)),
-            shear: [
-                F4::splat(-d[0] / d[2]),
-                F4::splat(-d[1] / d[2]),
-                F4::splat(1.0 / d[2]),
-            ],
+            shear: [F4::splat(sx), F4::splat(sy), F4::splat(sz)],
         }
     }
 }
