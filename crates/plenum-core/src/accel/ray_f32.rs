@@ -39,9 +39,9 @@ pub struct BoxRay {
     /// The origin rounded up, for the distances to min planes, and down, for max planes:
     /// whichever of the two is the entry, it is never overestimated, and the exit never
     /// underestimated, whatever the direction's sign.
-    origin_up: [f32; 3],
-    origin_down: [f32; 3],
-    inv_dir: [f32; 3],
+    origin_up: [F4; 3],
+    origin_down: [F4; 3],
+    inv_dir: [F4; 3],
 }
 
 /// Relative enlargement of exit distances: the subtraction, the multiplication and the two
@@ -63,10 +63,8 @@ impl BoxRay {
             .abs()
             .mul(F4::splat(f32::EPSILON))
             .add(F4::splat(f32::MIN_POSITIVE));
-        let xyz = |v: F4| {
-            let [x, y, z, _] = v.to_array();
-            [x, y, z]
-        };
+        // Lanes spread in registers: a store and narrower reloads would stall forwarding.
+        let xyz = F4::spread3;
         BoxRay {
             origin_up: xyz(o.add(ulp)),
             origin_down: xyz(o.sub(ulp)),
@@ -78,13 +76,12 @@ impl BoxRay {
     #[inline(always)]
     pub fn test4(&self, planes: &[[f32; 4]; 6], far: F4) -> (F4, u32) {
         let slab = |a: usize| {
-            let inv = F4::splat(self.inv_dir[a]);
             let t0 = F4::load(&planes[a])
-                .sub(F4::splat(self.origin_up[a]))
-                .mul(inv);
+                .sub(self.origin_up[a])
+                .mul(self.inv_dir[a]);
             let t1 = F4::load(&planes[3 + a])
-                .sub(F4::splat(self.origin_down[a]))
-                .mul(inv);
+                .sub(self.origin_down[a])
+                .mul(self.inv_dir[a]);
             (t0.min(t1), t0.max(t1))
         };
         let (x0, x1) = slab(0);
@@ -123,14 +120,8 @@ impl BoxRay {
     #[target_feature(enable = "avx")]
     #[inline]
     pub unsafe fn avx(&self) -> BoxRayAvx {
-        use std::arch::x86_64::_mm256_set1_ps;
-        let wide = |v: &[f32; 3]| {
-            [
-                _mm256_set1_ps(v[0]),
-                _mm256_set1_ps(v[1]),
-                _mm256_set1_ps(v[2]),
-            ]
-        };
+        use std::arch::x86_64::_mm256_set_m128;
+        let wide = |v: &[F4; 3]| v.map(|x| _mm256_set_m128(x.raw(), x.raw()));
         BoxRayAvx {
             origin_up: wide(&self.origin_up),
             origin_down: wide(&self.origin_down),

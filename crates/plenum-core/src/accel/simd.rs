@@ -31,6 +31,22 @@ mod imp {
             unsafe { _mm_storeu_ps(out.as_mut_ptr(), self.0) };
             out
         }
+        /// Lanes 0, 1 and 2, each spread over a whole vector without a trip through memory.
+        #[inline(always)]
+        pub fn spread3(self) -> [F4; 3] {
+            unsafe {
+                [
+                    F4(_mm_shuffle_ps::<0x00>(self.0, self.0)),
+                    F4(_mm_shuffle_ps::<0x55>(self.0, self.0)),
+                    F4(_mm_shuffle_ps::<0xAA>(self.0, self.0)),
+                ]
+            }
+        }
+        /// The SSE register, for 256-bit code built on it.
+        #[inline(always)]
+        pub fn raw(self) -> __m128 {
+            self.0
+        }
         #[inline(always)]
         pub fn add(self, o: F4) -> F4 {
             unsafe { F4(_mm_add_ps(self.0, o.0)) }
@@ -120,6 +136,10 @@ mod imp {
         #[inline(always)]
         pub fn to_array(self) -> [f32; 4] {
             self.0
+        }
+        #[inline(always)]
+        pub fn spread3(self) -> [F4; 3] {
+            [F4([self.0[0]; 4]), F4([self.0[1]; 4]), F4([self.0[2]; 4])]
         }
         #[inline(always)]
         pub fn add(self, o: F4) -> F4 {

@@ -238,10 +238,12 @@ impl TriangleMesh {
 
     /// The nearest hit in (0, t_max).
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
-        let sheared = ShearedRay::new(ray);
+        // Prepared at the first leaf: most rays that miss never reach one.
+        let mut sheared = None;
         let mut best = None;
         self.visit_blocks(ray, t_max, |corners, ids, count, t_max| {
-            if let Some(hit) = self.intersect_block(&sheared, ray, corners, ids, count, *t_max) {
+            let r = sheared.get_or_insert_with(|| ShearedRay::new(ray));
+            if let Some(hit) = self.intersect_block(r, ray, corners, ids, count, *t_max) {
                 *t_max = hit.t;
                 best = Some(hit);
             }
@@ -252,10 +254,11 @@ impl TriangleMesh {
 
     /// Some hit in (0, t_max), not necessarily the nearest: stops at the first one found.
     pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
-        let sheared = ShearedRay::new(ray);
+        let mut sheared = None;
         let mut found = None;
         self.visit_blocks(ray, t_max, |corners, ids, count, t_max| {
-            found = self.intersect_block(&sheared, ray, corners, ids, count, *t_max);
+            let r = sheared.get_or_insert_with(|| ShearedRay::new(ray));
+            found = self.intersect_block(r, ray, corners, ids, count, *t_max);
             found.is_none()
         });
         found
