@@ -24,9 +24,11 @@ use std::ops::Range;
 const BINS: usize = 16;
 /// Children per node.
 const WIDTH: usize = 8;
-/// Deepest binary split; bounds the traversal stack (three entries per level at most).
+/// Depth (in binary splits) past which runs are halved instead of split by cost.
 const MAX_DEPTH: usize = 64;
-const STACK: usize = 7 * MAX_DEPTH + 8;
+/// A node pushes at most seven children. Nodes sit at most MAX_DEPTH / 2 levels deep where
+/// splits are binned, and then at most 31 levels more, as every level halves the items.
+const STACK: usize = 7 * (MAX_DEPTH / 2 + 32);
 /// Cost of visiting a node relative to testing one leaf block.
 const TRAVERSAL_COST: f32 = 1.0;
 /// Subtrees with more items than this are built in parallel.
@@ -220,15 +222,13 @@ impl Bvh {
     fn prefetch(&self, child: u32) {
         #[cfg(target_arch = "x86_64")]
         if child & LEAF_BIT == 0 {
-            if let Some(node) = self.nodes.get(child as usize) {
-                let p = node as *const Node as *const i8;
-                // SAFETY: prefetching is a hint; the address is that of a live node and the
-                // second line lies inside it (nodes are 256 bytes, aligned to 64).
-                unsafe {
-                    use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-                    _mm_prefetch(p, _MM_HINT_T0);
-                    _mm_prefetch(p.add(64), _MM_HINT_T0);
-                }
+            // A prefetch never faults, so the address needs no bounds check.
+            let p = self.nodes.as_ptr().wrapping_add(child as usize) as *const i8;
+            // SAFETY: prefetching is only a hint.
+            unsafe {
+                use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+                _mm_prefetch(p, _MM_HINT_T0);
+                _mm_prefetch(p.wrapping_add(64), _MM_HINT_T0);
             }
         }
     }
@@ -312,13 +312,16 @@ impl Bvh {
                 }
                 far = round_up(t_max);
             } else {
-                let node = &self.nodes[current as usize];
+                debug_assert!((current as usize) < self.nodes.len());
+                // SAFETY: interior references are indices of nodes, written by `flatten`.
+                let node = unsafe { self.nodes.get_unchecked(current as usize) };
                 let (near, hits) = test(&node.planes, far);
-                let mut hits = hits & node.used;
+                // Eight lanes: indices below stay under eight.
+                let mut hits = hits & node.used & 0xFF;
                 if hits != 0 {
                     // The nearest hit child is visited next; the others wait on the stack,
                     // nearest on top.
-                    let first = hits.trailing_zeros() as usize;
+                    let first = hits.trailing_zeros() as usize & 7;
                     hits &= hits - 1;
                     if hits == 0 {
                         current = node.children[first];
@@ -327,7 +330,7 @@ impl Bvh {
                     let mut best = (node.children[first], near[first]);
                     let base = top;
                     while hits != 0 {
-                        let i = hits.trailing_zeros() as usize;
+                        let i = hits.trailing_zeros() as usize & 7;
                         hits &= hits - 1;
                         let mut entry = (node.children[i], near[i]);
                         self.prefetch(entry.0);
@@ -335,13 +338,17 @@ impl Bvh {
                             std::mem::swap(&mut entry, &mut best);
                         }
                         // Insert keeping [base, top) sorted by decreasing distance.
-                        let mut j = top;
-                        // SAFETY: entries in [base, top) were written above.
-                        while j > base && unsafe { stack[j - 1].assume_init() }.1 < entry.1 {
-                            stack[j] = stack[j - 1];
-                            j -= 1;
+                        debug_assert!(top < STACK);
+                        // SAFETY: `top` stays below STACK (see there); entries in [base, top)
+                        // were written above.
+                        unsafe {
+                            let mut j = top;
+                            while j > base && stack.get_unchecked(j - 1).assume_init().1 < entry.1 {
+                                *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
+                                j -= 1;
+                            }
+                            stack.get_unchecked_mut(j).write(entry);
                         }
-                        stack[j].write(entry);
                         top += 1;
                     }
                     current = best.0;
@@ -356,7 +363,7 @@ impl Bvh {
                 }
                 top -= 1;
                 // SAFETY: entries below `top` were written when pushed.
-                let (next, near) = unsafe { stack[top].assume_init() };
+                let (next, near) = unsafe { stack.get_unchecked(top).assume_init() };
                 if near <= limit {
                     current = next;
                     break;
@@ -436,8 +443,13 @@ impl Builder {
     fn split(&self, items: &mut [Item], bounds: &Aabb, depth: usize) -> Option<usize> {
         let n = items.len();
         let must_split = n > self.max_leaf;
-        if n <= 1 || (depth + 2 >= MAX_DEPTH && !must_split) {
+        if n <= 1 {
             return None;
+        }
+        if depth + 2 >= MAX_DEPTH {
+            // Halve the run: every level below then at least halves, which bounds the depth
+            // (and the traversal stack) whatever the boxes.
+            return must_split.then_some(n / 2);
         }
         let mut centers = Aabb::EMPTY;
         for it in items.iter() {

@@ -241,9 +241,9 @@ impl TriangleMesh {
         // Prepared at the first leaf: most rays that miss never reach one.
         let mut sheared = None;
         let mut best = None;
-        self.visit_blocks(ray, t_max, |corners, ids, count, t_max| {
+        self.visit_blocks(ray, t_max, |ids, count, t_max| {
             let r = sheared.get_or_insert_with(|| ShearedRay::new(ray));
-            if let Some(hit) = self.intersect_block(r, ray, corners, ids, count, *t_max) {
+            if let Some(hit) = self.intersect_block(r, ray, ids, count, *t_max) {
                 *t_max = hit.t;
                 best = Some(hit);
             }
@@ -256,23 +256,23 @@ impl TriangleMesh {
     pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
         let mut sheared = None;
         let mut found = None;
-        self.visit_blocks(ray, t_max, |corners, ids, count, t_max| {
+        self.visit_blocks(ray, t_max, |ids, count, t_max| {
             let r = sheared.get_or_insert_with(|| ShearedRay::new(ray));
-            found = self.intersect_block(r, ray, corners, ids, count, *t_max);
+            found = self.intersect_block(r, ray, ids, count, *t_max);
             found.is_none()
         });
         found
     }
 
-    /// Hands `test(corners, ids, count, t_max)` blocks of up to four triangles the ray may
-    /// meet, roughly nearest first, until it returns false. Lanes past `count` repeat the last
+    /// Hands `test(ids, count, t_max)` blocks of up to four triangles the ray may meet,
+    /// roughly nearest first, until it returns false. Lanes past `count` repeat the last
     /// triangle.
     #[inline(always)]
     fn visit_blocks(
         &self,
         ray: &Ray,
         t_max: f64,
-        mut test: impl FnMut(&[[F4; 3]; 3], [u32; 4], usize, &mut f64) -> bool,
+        mut test: impl FnMut([u32; 4], usize, &mut f64) -> bool,
     ) {
         if let Accel::Bvh(bvh) = &self.accel {
             // Leaves are runs of the stored triangles: no index to read per triangle.
@@ -281,7 +281,7 @@ impl TriangleMesh {
                 for base in run.step_by(4).map(|b| b as u32) {
                     let ids = [0, 1, 2, 3].map(|lane| (base + lane).min(last));
                     let count = (last - base + 1).min(4) as usize;
-                    if !test(&self.corners(ids), ids, count, t_max) {
+                    if !test(ids, count, t_max) {
                         return false;
                     }
                 }
@@ -293,7 +293,7 @@ impl TriangleMesh {
             for block in items.chunks(4) {
                 let last = block.len() - 1;
                 let ids = [0, 1, 2, 3].map(|lane| block[lane.min(last)]);
-                if !test(&self.corners(ids), ids, block.len(), t_max) {
+                if !test(ids, block.len(), t_max) {
                     return false;
                 }
             }
@@ -304,7 +304,9 @@ impl TriangleMesh {
     /// The corners of four triangles in lanes: `[corner][axis]`.
     #[inline(always)]
     fn corners(&self, ids: [u32; 4]) -> [[F4; 3]; 3] {
-        let tri = |lane: usize| self.triangles[ids[lane] as usize];
+        debug_assert!(ids.iter().all(|&i| (i as usize) < self.triangles.len()));
+        // SAFETY: ids come from the structure built over these triangles.
+        let tri = |lane: usize| unsafe { *self.triangles.get_unchecked(ids[lane] as usize) };
         let (t0, t1, t2, t3) = (tri(0), tri(1), tri(2), tri(3));
         let corner = |k: usize| {
             let p = |t: [u32; 3]| {
@@ -317,18 +319,18 @@ impl TriangleMesh {
         [corner(0), corner(1), corner(2)]
     }
 
-    /// The nearest hit among up to four triangles, tested together: `corners[k][axis]` holds
-    /// corner k of each, `ids` their indices; lanes from `count` on are ignored.
+    /// The nearest hit among up to four triangles, tested together; lanes from `count` on
+    /// are ignored.
     #[inline(always)]
     fn intersect_block(
         &self,
         r: &ShearedRay,
         ray: &Ray,
-        corners: &[[F4; 3]; 3],
         block: [u32; 4],
         count: usize,
         t_max: f64,
     ) -> Option<HitRecord> {
+        let corners = &self.corners(block);
         // One copy of the test per axis the ray runs along, so the permutation is static.
         match r.axes[2] {
             0 => self.intersect_block_along::<0>(r, ray, corners, block, count, t_max),
