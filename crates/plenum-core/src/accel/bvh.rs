@@ -30,7 +30,7 @@ const MAX_DEPTH: usize = 64;
 /// splits are binned, and then at most 31 levels more, as every level halves the items.
 const STACK: usize = 7 * (MAX_DEPTH / 2 + 32);
 /// Cost of visiting a node relative to testing one leaf block.
-const TRAVERSAL_COST: f32 = 1.0;
+const TRAVERSAL_COST: f32 = 0.5;
 /// Subtrees with more items than this are built in parallel.
 const PARALLEL_ITEMS: usize = 4096;
 
