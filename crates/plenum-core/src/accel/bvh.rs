@@ -257,33 +257,57 @@ impl Bvh {
         t_max: f64,
         visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
+        self.traverse_dispatch::<true>(ray, t_max, visit);
+    }
+
+    /// [`Bvh::traverse_runs`] for a caller that stops at any hit, such as a shadow ray: the
+    /// leaves come in no particular order, which spares sorting the children of each node.
+    #[inline]
+    pub fn traverse_runs_any_order(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        visit: impl FnMut(Range<usize>, &mut f64) -> bool,
+    ) {
+        self.traverse_dispatch::<false>(ray, t_max, visit);
+    }
+
+    #[inline(always)]
+    fn traverse_dispatch<const NEAREST_FIRST: bool>(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        visit: impl FnMut(Range<usize>, &mut f64) -> bool,
+    ) {
         if self.nodes.is_empty() {
             return;
         }
         let r = BoxRay::new(ray);
         #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx") {
-            // SAFETY: the CPU has AVX.
-            return unsafe { self.traverse_avx(&r, t_max, visit) };
+        if std::is_x86_feature_detected!("avx") && std::is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU has AVX and FMA.
+            return unsafe { self.traverse_avx::<NEAREST_FIRST>(&r, t_max, visit) };
         }
-        self.traverse_with(t_max, visit, |planes, far| r.test8(planes, F4::splat(far)));
+        self.traverse_with::<NEAREST_FIRST>(t_max, visit, |planes, far| {
+            r.test8(planes, F4::splat(far))
+        });
     }
 
     /// The traversal with eight boxes tested per AVX instruction.
     ///
     /// # Safety
-    /// The CPU must support AVX.
+    /// The CPU must support AVX and FMA.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    unsafe fn traverse_avx(
+    #[target_feature(enable = "avx,fma")]
+    unsafe fn traverse_avx<const NEAREST_FIRST: bool>(
         &self,
         r: &BoxRay,
         t_max: f64,
         visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
-        // SAFETY: this function runs only where the CPU has AVX.
+        // SAFETY: this function runs only where the CPU has AVX and FMA.
         let wide = unsafe { r.avx() };
-        self.traverse_with(t_max, visit, |planes, far| unsafe {
+        self.traverse_with::<NEAREST_FIRST>(t_max, visit, |planes, far| unsafe {
             wide.test8(planes, far)
         });
     }
@@ -291,7 +315,7 @@ impl Bvh {
     /// The traversal, with `test(planes, far)` giving a node's eight entry distances and
     /// the mask of the children the ray crosses before `far`.
     #[inline(always)]
-    fn traverse_with(
+    fn traverse_with<const NEAREST_FIRST: bool>(
         &self,
         t_max: f64,
         mut visit: impl FnMut(Range<usize>, &mut f64) -> bool,
@@ -319,14 +343,32 @@ impl Bvh {
                 // Eight lanes: indices below stay under eight.
                 let mut hits = hits & node.used & 0xFF;
                 if hits != 0 {
-                    // The nearest hit child is visited next; the others wait on the stack,
-                    // nearest on top.
                     let first = hits.trailing_zeros() as usize & 7;
                     hits &= hits - 1;
                     if hits == 0 {
                         current = node.children[first];
                         continue;
                     }
+                    if !NEAREST_FIRST {
+                        // Any order will do (as for shadow rays): no distances compared.
+                        current = node.children[first];
+                        while hits != 0 {
+                            let i = hits.trailing_zeros() as usize & 7;
+                            hits &= hits - 1;
+                            self.prefetch(node.children[i]);
+                            debug_assert!(top < STACK);
+                            // SAFETY: `top` stays below STACK (see there).
+                            unsafe {
+                                stack
+                                    .get_unchecked_mut(top)
+                                    .write((node.children[i], near[i]))
+                            };
+                            top += 1;
+                        }
+                        continue;
+                    }
+                    // The nearest hit child is visited next; the others wait on the stack,
+                    // nearest on top.
                     let mut best = (node.children[first], near[first]);
                     let base = top;
                     while hits != 0 {

@@ -10,6 +10,7 @@ use crate::accel::ray_f32::{gamma_f32, round_up};
 use crate::accel::simd::F4;
 use crate::accel::{Accel, AccelKind, LeafSize};
 use crate::math::{gamma, Bounds3, Ray, Vec3};
+use std::ops::Range;
 
 /// Four triangles per SIMD test, up to two tests per BVH leaf.
 const LEAF: LeafSize = LeafSize {
@@ -155,7 +156,35 @@ impl TriangleMesh {
             }
             self.triangles = order.iter().map(|&i| self.triangles[i as usize]).collect();
             self.source = order.iter().map(|&i| self.source[i as usize]).collect();
+            self.number_vertices_by_first_use();
         }
+    }
+
+    /// Renumbers the vertices in the order the triangles first use them, so that the corners
+    /// of a leaf's triangles share a few cache lines instead of scattering over the mesh.
+    fn number_vertices_by_first_use(&mut self) {
+        const UNSEEN: u32 = u32::MAX;
+        let mut new_index = vec![UNSEEN; self.positions.len()];
+        let mut old_index = Vec::with_capacity(self.positions.len());
+        for v in self.triangles.iter_mut().flatten() {
+            if new_index[*v as usize] == UNSEEN {
+                new_index[*v as usize] = old_index.len() as u32;
+                old_index.push(*v);
+            }
+            *v = new_index[*v as usize];
+        }
+        // Vertices no triangle uses keep their place after the others.
+        old_index
+            .extend((0..self.positions.len() as u32).filter(|&v| new_index[v as usize] == UNSEEN));
+        fn permute<T: Copy>(values: &mut Vec<T>, old_index: &[u32]) {
+            if !values.is_empty() {
+                *values = old_index.iter().map(|&v| values[v as usize]).collect();
+            }
+        }
+        permute(&mut self.positions, &old_index);
+        permute(&mut self.packed, &old_index);
+        permute(&mut self.normals, &old_index);
+        permute(&mut self.uvs, &old_index);
     }
 
     fn clone_without_accel(&self) -> TriangleMesh {
@@ -241,7 +270,7 @@ impl TriangleMesh {
         // Prepared at the first leaf: most rays that miss never reach one.
         let mut sheared = None;
         let mut best = None;
-        self.visit_blocks(ray, t_max, |ids, count, t_max| {
+        self.visit_blocks::<true>(ray, t_max, |ids, count, t_max| {
             let r = sheared.get_or_insert_with(|| ShearedRay::new(ray));
             if let Some(hit) = self.intersect_block(r, ray, ids, count, *t_max) {
                 *t_max = hit.t;
@@ -256,7 +285,7 @@ impl TriangleMesh {
     pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
         let mut sheared = None;
         let mut found = None;
-        self.visit_blocks(ray, t_max, |ids, count, t_max| {
+        self.visit_blocks::<false>(ray, t_max, |ids, count, t_max| {
             let r = sheared.get_or_insert_with(|| ShearedRay::new(ray));
             found = self.intersect_block(r, ray, ids, count, *t_max);
             found.is_none()
@@ -265,10 +294,10 @@ impl TriangleMesh {
     }
 
     /// Hands `test(ids, count, t_max)` blocks of up to four triangles the ray may meet,
-    /// roughly nearest first, until it returns false. Lanes past `count` repeat the last
-    /// triangle.
+    /// roughly nearest first if `NEAREST_FIRST`, until it returns false. Lanes past `count`
+    /// repeat the last triangle.
     #[inline(always)]
-    fn visit_blocks(
+    fn visit_blocks<const NEAREST_FIRST: bool>(
         &self,
         ray: &Ray,
         t_max: f64,
@@ -276,7 +305,7 @@ impl TriangleMesh {
     ) {
         if let Accel::Bvh(bvh) = &self.accel {
             // Leaves are runs of the stored triangles: no index to read per triangle.
-            bvh.traverse_runs(ray, t_max, |run, t_max| {
+            let visit_run = |run: Range<usize>, t_max: &mut f64| {
                 let last = run.end as u32 - 1;
                 for base in run.step_by(4).map(|b| b as u32) {
                     let ids = [0, 1, 2, 3].map(|lane| (base + lane).min(last));
@@ -286,7 +315,12 @@ impl TriangleMesh {
                     }
                 }
                 true
-            });
+            };
+            if NEAREST_FIRST {
+                bvh.traverse_runs(ray, t_max, visit_run);
+            } else {
+                bvh.traverse_runs_any_order(ray, t_max, visit_run);
+            }
             return;
         }
         self.accel.traverse(ray, t_max, |items, t_max| {
