@@ -214,6 +214,25 @@ proptest! {
     ) {
         check_mesh(&triangles, &rays)?;
     }
+
+    /// Small triangles in a few far-apart clusters: most of the grid's macro cells are
+    /// empty, so rays cross them in jumps and resume cell by cell inside full ones.
+    #[test]
+    fn clustered_triangle_soups_agree(
+        clusters in prop::collection::vec(
+            (vec3(10.0), prop::collection::vec((vec3(0.8), vec3(0.3), vec3(0.3)), 100..300)),
+            2..5,
+        ),
+        rays in rays(),
+    ) {
+        let triangles: Vec<[Vec3; 3]> = clusters
+            .iter()
+            .flat_map(|(center, tris)| {
+                tris.iter().map(move |&(c, a, b)| [*center + c, *center + c + a, *center + c + b])
+            })
+            .collect();
+        check_mesh(&triangles, &rays)?;
+    }
 }
 
 #[test]

@@ -5,7 +5,8 @@
 //!
 //! Most of a ray's cells are empty, and stepping through them one by one is most of the
 //! cost. So the grid also keeps which blocks of 4 × 4 × 4 cells (macro cells) hold anything,
-//! and a ray crosses an empty block in one jump to its far wall.
+//! and a ray crosses an empty block in one jump to its far wall. Every step stays within
+//! the cells the ray touches up to rounding, which the margin items are filed with covers.
 
 use super::mailbox::{new_owner, Mailbox};
 use crate::math::{Bounds3, Ray, Vec3};
@@ -129,13 +130,10 @@ impl Grid {
         if size <= 0.0 {
             return 0;
         }
-        // Truncation is floor here (c ≥ 0), without a call into libm.
+        // Truncation is floor here (c ≥ 0), without a call into libm; a signed conversion
+        // is one instruction, and the clamp keeps it in range.
         let c = (x - self.bounds.min[axis]) / size;
-        if c > 0.0 {
-            (c as usize).min(self.resolution[axis] - 1)
-        } else {
-            0
-        }
+        (c.min(MAX_RESOLUTION as f64) as i64).clamp(0, self.resolution[axis] as i64 - 1) as usize
     }
 
     fn for_cells(&self, b: &Bounds3, mut f: impl FnMut(usize)) {
@@ -153,6 +151,9 @@ impl Grid {
 
     /// Visits the cells the ray crosses in order, handing `visit` the untested items of each
     /// (see [`super::Accel::traverse`]).
+    ///
+    /// Two walks in step: one over macro cells, which crosses an empty one in a single step,
+    /// and one over the cells of each macro cell that holds anything.
     pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
         if self.items.is_empty() {
             return;
@@ -160,120 +161,178 @@ impl Grid {
         let Some((t_enter, t_exit)) = self.bounds.intersect_interval(ray, t_max) else {
             return;
         };
+        let walk = Walk::new(self, ray);
+        let mut limit = t_max.min(t_exit);
         let mut t_max = t_max;
         let p = ray.at(t_enter);
-        let mut cell = [0usize; 3];
-        let mut step = [0isize; 3];
-        let mut next = [f64::INFINITY; 3];
-        let mut delta = [f64::INFINITY; 3];
+        let mut cell = [0; 3];
         for a in 0..3 {
             cell[a] = self.cell_of(p[a], a);
-            let d = ray.direction[a];
-            if d > 0.0 {
-                step[a] = 1;
-                let edge = self.bounds.min[a] + (cell[a] + 1) as f64 * self.cell_size[a];
-                next[a] = (edge - ray.origin[a]) / d;
-                delta[a] = self.cell_size[a] / d;
-            } else if d < 0.0 {
-                step[a] = -1;
-                let edge = self.bounds.min[a] + cell[a] as f64 * self.cell_size[a];
-                next[a] = (edge - ray.origin[a]) / d;
-                delta[a] = -self.cell_size[a] / d;
-            }
         }
-        let mailbox = Mailbox::start(self.owner, self.item_count);
-        let [nx, ny, _] = self.resolution;
-        let [mx, my, _] = self.macro_resolution;
+        let mut next = walk.walls(self, cell, 1);
+        let mut block = cell.map(|x| x / MACRO);
+        let mut block_next = walk.walls(self, block, MACRO);
+        let mut m = self.macro_index(cell);
+        // The cell walk is under way inside the current macro cell; when not, the ray
+        // entered this macro cell at `t_block` through a wall across `entered_along`.
+        let mut walking = true;
+        let (mut t_block, mut entered_along) = (t_enter, 0);
+        let mut mailbox = None;
         loop {
-            let m = ((cell[2] / MACRO) * my + cell[1] / MACRO) * mx + cell[0] / MACRO;
-            if !self.macro_full[m] {
-                // Jump across the empty macro cell: find the axis whose macro wall comes
-                // first, move there, and bring the other axes up to that time.
-                let walls = [0, 1, 2].map(|a| {
-                    let first = cell[a] / MACRO * MACRO;
-                    let last = (first + MACRO).min(self.resolution[a]) - 1;
-                    if step[a] > 0 {
-                        last - cell[a]
-                    } else {
-                        cell[a] - first
+            if self.macro_full[m] {
+                if !walking {
+                    cell = self.entry_cell(ray.at(t_block), block, entered_along, &walk);
+                    next = walk.walls(self, cell, 1);
+                    walking = true;
+                }
+                let mut c = self.index(cell);
+                // Walk the cells until the ray leaves the macro cell along axis `a`.
+                let a = loop {
+                    let (first, end) = (self.starts[c] as usize, self.starts[c + 1] as usize);
+                    if first < end {
+                        let mailbox = mailbox
+                            .get_or_insert_with(|| Mailbox::start(self.owner, self.item_count));
+                        if !mailbox.visit_untested(&self.items[first..end], &mut t_max, &mut visit)
+                        {
+                            return;
+                        }
+                        limit = t_max.min(t_exit);
                     }
-                });
-                // An axis the ray does not move along is never crossed (and 0 · ∞ is NaN).
-                let crossing = [0, 1, 2].map(|a| {
-                    if step[a] == 0 {
-                        f64::INFINITY
-                    } else {
-                        next[a] + walls[a] as f64 * delta[a]
+                    let a = nearest(next);
+                    if next[a] > limit {
+                        return;
                     }
-                });
-                let a = if crossing[0] < crossing[1] {
-                    if crossing[0] < crossing[2] {
-                        0
-                    } else {
-                        2
+                    cell[a] = cell[a].wrapping_add_signed(walk.step[a]);
+                    if cell[a] >= self.resolution[a] {
+                        return;
                     }
-                } else if crossing[1] < crossing[2] {
-                    1
-                } else {
-                    2
+                    c = c.wrapping_add_signed(walk.stride[a]);
+                    next[a] += walk.delta[a];
+                    if cell[a] / MACRO != block[a] {
+                        break a;
+                    }
                 };
-                let t_out = crossing[a];
-                if t_max < t_out || t_out > t_exit {
-                    return;
-                }
-                for b in 0..3 {
-                    if b == a || step[b] == 0 {
-                        continue;
-                    }
-                    // Walls crossed before t_out, rounded down: being a cell behind only
-                    // visits an empty cell; being a cell ahead could skip a full one.
-                    let x = (t_out - next[b]) / delta[b];
-                    let x = x - 1e-9 * (1.0 + x);
-                    let crossed = if x > 0.0 {
-                        // ⌈x⌉ without a call into libm.
-                        let whole = x as usize;
-                        (whole + usize::from((whole as f64) < x)).min(walls[b])
-                    } else {
-                        0
-                    };
-                    cell[b] = (cell[b] as isize + step[b] * crossed as isize) as usize;
-                    next[b] += crossed as f64 * delta[b];
-                }
-                let moved = cell[a] as isize + step[a] * (walls[a] as isize + 1);
-                if moved < 0 || moved >= self.resolution[a] as isize {
-                    return;
-                }
-                cell[a] = moved as usize;
-                next[a] = t_out + delta[a];
-                continue;
-            }
-            let c = (cell[2] * ny + cell[1]) * nx + cell[0];
-            let items = &self.items[self.starts[c] as usize..self.starts[c + 1] as usize];
-            if !mailbox.visit_untested(items, &mut t_max, &mut visit) {
-                return;
-            }
-            // Step to the neighbour across the nearest cell wall.
-            let a = if next[0] < next[1] {
-                if next[0] < next[2] {
-                    0
-                } else {
-                    2
-                }
-            } else if next[1] < next[2] {
-                1
+                // The cell walk carries on in the neighbouring macro cell.
+                block[a] = block[a].wrapping_add_signed(walk.step[a]);
+                block_next[a] += walk.delta[a] * MACRO as f64;
+                m = m.wrapping_add_signed(walk.macro_stride[a]);
             } else {
-                2
-            };
-            // A hit before the wall cannot be beaten by anything in later cells.
-            if t_max < next[a] || next[a] > t_exit {
-                return;
+                let a = nearest(block_next);
+                if block_next[a] > limit {
+                    return;
+                }
+                block[a] = block[a].wrapping_add_signed(walk.step[a]);
+                if block[a] >= self.macro_resolution[a] {
+                    return;
+                }
+                m = m.wrapping_add_signed(walk.macro_stride[a]);
+                (t_block, entered_along) = (block_next[a], a);
+                block_next[a] += walk.delta[a] * MACRO as f64;
+                walking = false;
             }
-            let moved = cell[a] as isize + step[a];
-            if moved < 0 || moved >= self.resolution[a] as isize {
-                return;
-            }
-            cell[a] = moved as usize;
-            next[a] += delta[a];
         }
+    }
+
+    /// The cell of macro cell `block` where a ray that entered it at `p` across a wall
+    /// along axis `entered` starts: on that axis the first row it meets, on the others
+    /// where `p` lies, kept within the macro cell against rounding.
+    fn entry_cell(&self, p: Vec3, block: [usize; 3], entered: usize, walk: &Walk) -> [usize; 3] {
+        let mut cell = [0; 3];
+        for a in 0..3 {
+            let low = block[a] * MACRO;
+            let high = (low + MACRO).min(self.resolution[a]) - 1;
+            cell[a] = if a != entered {
+                self.cell_of(p[a], a).clamp(low, high)
+            } else if walk.step[a] > 0 {
+                low
+            } else {
+                high
+            };
+        }
+        cell
+    }
+
+    fn index(&self, cell: [usize; 3]) -> usize {
+        let [nx, ny, _] = self.resolution;
+        (cell[2] * ny + cell[1]) * nx + cell[0]
+    }
+
+    fn macro_index(&self, cell: [usize; 3]) -> usize {
+        let [mx, my, _] = self.macro_resolution;
+        ((cell[2] / MACRO) * my + cell[1] / MACRO) * mx + cell[0] / MACRO
+    }
+}
+
+/// A ray's constants for walking the grid.
+struct Walk {
+    origin: Vec3,
+    inv_dir: Vec3,
+    /// −1, 0 or +1 cell per step along each axis.
+    step: [isize; 3],
+    /// The change of the cell index per step along each axis, and of the macro cell index.
+    stride: [isize; 3],
+    macro_stride: [isize; 3],
+    /// The time between walls along each axis.
+    delta: [f64; 3],
+}
+
+impl Walk {
+    fn new(grid: &Grid, ray: &Ray) -> Walk {
+        let [nx, ny, _] = grid.resolution;
+        let d = ray.direction;
+        let step = [0, 1, 2].map(|a| (d[a] > 0.0) as isize - (d[a] < 0.0) as isize);
+        let [mx, my, _] = grid.macro_resolution;
+        let strides = [1, nx as isize, (nx * ny) as isize];
+        let macro_strides = [1, mx as isize, (mx * my) as isize];
+        Walk {
+            origin: ray.origin,
+            inv_dir: Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z),
+            step,
+            stride: [0, 1, 2].map(|a| step[a] * strides[a]),
+            macro_stride: [0, 1, 2].map(|a| step[a] * macro_strides[a]),
+            delta: [0, 1, 2].map(|a| match step[a] {
+                0 => f64::INFINITY,
+                _ => (grid.cell_size[a] / d[a]).abs(),
+            }),
+        }
+    }
+
+    /// When the ray crosses wall `wall` (the low wall of that cell) along axis `a`.
+    fn time_at(&self, grid: &Grid, a: usize, wall: usize) -> f64 {
+        // Through i64: an unsigned conversion to f64 takes several instructions.
+        let x = grid.bounds.min[a] + wall as i64 as f64 * grid.cell_size[a];
+        (x - self.origin[a]) * self.inv_dir[a]
+    }
+
+    /// When the ray leaves `cell`, in cells `size` wide (1, or MACRO for macro cells),
+    /// through each axis's wall ahead (never along an axis it does not move along).
+    fn walls(&self, grid: &Grid, cell: [usize; 3], size: usize) -> [f64; 3] {
+        let mut t = [f64::INFINITY; 3];
+        for a in 0..3 {
+            if self.step[a] != 0 {
+                let ahead = if self.step[a] > 0 {
+                    cell[a] + 1
+                } else {
+                    cell[a]
+                };
+                t[a] = self.time_at(grid, a, ahead * size);
+            }
+        }
+        t
+    }
+}
+
+/// The axis of the smallest of three times.
+fn nearest(t: [f64; 3]) -> usize {
+    if t[0] < t[1] {
+        if t[0] < t[2] {
+            0
+        } else {
+            2
+        }
+    } else if t[1] < t[2] {
+        1
+    } else {
+        2
     }
 }
