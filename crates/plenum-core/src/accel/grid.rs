@@ -9,6 +9,7 @@
 //! the cells the ray touches up to rounding, which the margin items are filed with covers.
 
 use super::mailbox::{new_owner, Mailbox};
+use super::nearest;
 use crate::math::{Bounds3, Ray, Vec3};
 
 /// Cells per item.
@@ -319,20 +320,5 @@ impl Walk {
             }
         }
         t
-    }
-}
-
-/// The axis of the smallest of three times.
-fn nearest(t: [f64; 3]) -> usize {
-    if t[0] < t[1] {
-        if t[0] < t[2] {
-            0
-        } else {
-            2
-        }
-    } else if t[1] < t[2] {
-        1
-    } else {
-        2
     }
 }

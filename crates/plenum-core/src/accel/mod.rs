@@ -154,3 +154,18 @@ impl Accel {
         }
     }
 }
+
+/// The axis of the smallest of three times (the grid's and the octree's next wall).
+fn nearest(t: [f64; 3]) -> usize {
+    if t[0] < t[1] {
+        if t[0] < t[2] {
+            0
+        } else {
+            2
+        }
+    } else if t[1] < t[2] {
+        1
+    } else {
+        2
+    }
+}

@@ -1,10 +1,12 @@
 //! An adaptive octree: a cell holding more than a few items is split at its centre into
 //! eight, to a depth limit. Traversal is the parametric algorithm of Revelles, Ureña and
-//! Lastra (2000): from the distances at which the ray crosses a cell's three mid-planes it
-//! knows, without testing boxes, which children it passes through and in what order, so the
-//! cells are visited front to back. Items filed in several cells are mailboxed.
+//! Lastra (2000): a cell carries the distances at which the ray crosses its six planes; the
+//! mid-planes' are their averages, and from them the traversal knows, without testing
+//! boxes, which children the ray passes through and in what order, so the cells are
+//! visited front to back. Items filed in several cells are mailboxed.
 
 use super::mailbox::{new_owner, Mailbox};
+use super::nearest;
 use crate::math::{Bounds3, Ray, Vec3};
 use std::mem::MaybeUninit;
 
@@ -13,18 +15,35 @@ const MAX_DEPTH: usize = 16;
 /// A ray passes through at most four of a cell's children.
 const STACK: usize = 3 * MAX_DEPTH + 2;
 
-#[derive(Clone, Debug)]
+/// A cell: a leaf with a run of items, or a parent of eight cells.
+#[derive(Clone, Copy, Debug)]
 struct OctNode {
-    /// Index of the first of eight consecutive children; 0 for a leaf.
-    first_child: u32,
-    start: u32,
-    count: u32,
+    /// A leaf's first item in `items`; a parent's block of children in `blocks`.
+    first: u32,
+    /// A leaf's item count with the LEAF bit. A parent's children that hold anything, bit
+    /// k for child k, so traversal skips empty ones without reading them.
+    info: u32,
 }
+
+const LEAF: u32 = 1 << 31;
+
+/// Eight siblings in one cache line, so a cell's children come in with one miss.
+#[derive(Clone, Debug)]
+#[repr(C, align(64))]
+struct Siblings([OctNode; 8]);
+
+const EMPTY_BLOCK: Siblings = Siblings(
+    [OctNode {
+        first: 0,
+        info: LEAF,
+    }; 8],
+);
 
 #[derive(Clone, Debug)]
 pub struct Octree {
     bounds: Bounds3,
-    nodes: Vec<OctNode>,
+    /// Cell `id` is `blocks[id / 8].0[id % 8]`; the root is cell 0, alone in its block.
+    blocks: Vec<Siblings>,
     items: Vec<u32>,
     item_count: usize,
     owner: u64,
@@ -58,11 +77,7 @@ impl Octree {
         });
         let mut tree = Octree {
             bounds,
-            nodes: vec![OctNode {
-                first_child: 0,
-                start: 0,
-                count: 0,
-            }],
+            blocks: vec![EMPTY_BLOCK],
             items: Vec::new(),
             item_count: item_bounds.len(),
             owner: new_owner(),
@@ -88,10 +103,9 @@ impl Octree {
         filed: &[Bounds3],
     ) {
         let make_leaf = |tree: &mut Octree, items: &[u32]| {
-            tree.nodes[node] = OctNode {
-                first_child: 0,
-                start: tree.items.len() as u32,
-                count: items.len() as u32,
+            *tree.node_mut(node) = OctNode {
+                first: tree.items.len() as u32,
+                info: LEAF | items.len() as u32,
             };
             tree.items.extend_from_slice(items);
         };
@@ -120,123 +134,128 @@ impl Octree {
         if copies > 2 * items.len() || children.iter().all(|c| c.len() == items.len()) {
             return make_leaf(self, &items);
         }
-        let first = self.nodes.len();
-        self.nodes[node].first_child = first as u32;
-        for _ in 0..8 {
-            self.nodes.push(OctNode {
-                first_child: 0,
-                start: 0,
-                count: 0,
-            });
-        }
+        let block = self.blocks.len();
+        self.blocks.push(EMPTY_BLOCK);
         drop(items);
+        let mut occupied = 0;
         for (octant, list) in children.into_iter().enumerate() {
+            occupied |= u32::from(!list.is_empty()) << octant;
             let (clo, chi) = child_box(lo, hi, octant);
-            self.build_node(first + octant, clo, chi, list, depth + 1, filed);
+            self.build_node(block * 8 + octant, clo, chi, list, depth + 1, filed);
         }
+        *self.node_mut(node) = OctNode {
+            first: block as u32,
+            info: occupied,
+        };
+    }
+
+    fn node(&self, id: usize) -> OctNode {
+        self.blocks[id / 8].0[id % 8]
+    }
+
+    fn node_mut(&mut self, id: usize) -> &mut OctNode {
+        &mut self.blocks[id / 8].0[id % 8]
     }
 
     pub fn bounds(&self) -> Bounds3 {
         self.bounds
     }
 
-    pub fn node_count(&self) -> usize {
-        self.nodes.len()
-    }
-
     pub fn memory_bytes(&self) -> usize {
-        self.nodes.len() * std::mem::size_of::<OctNode>() + self.items.len() * 4
+        self.blocks.len() * std::mem::size_of::<Siblings>() + self.items.len() * 4
     }
 
     /// Visits the leaves the ray crosses front to back, handing `visit` their untested items
     /// (see [`super::Accel::traverse`]).
     pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
-        if self.items.is_empty() {
+        if self.items.is_empty() || self.bounds.intersect_interval(ray, t_max).is_none() {
             return;
         }
-        let Some((t_enter, t_exit)) = self.bounds.intersect_interval(ray, t_max) else {
-            return;
-        };
         let mut t_max = t_max;
-        // A zero direction component becomes a tiny one of the same sign: its plane is then
+        // As Revelles et al. do, mirror the ray about the tree's centre along each axis it
+        // runs down, so that it runs up every axis; octant bits in `flip` undo the mirroring.
+        // A zero direction component becomes a tiny positive one: its planes are then
         // crossed at ±huge distances, never inside a cell, which is the right answer.
-        let dir = ray.direction;
-        let inv = [0, 1, 2].map(|a| {
-            let d = if dir[a].abs() < 1e-300 {
-                1e-300f64.copysign(dir[a])
-            } else {
-                dir[a]
-            };
-            1.0 / d
-        });
-        let mailbox = Mailbox::start(self.owner, self.item_count);
+        let (lo, hi) = (self.bounds.min, self.bounds.max);
+        let mut flip = 0;
+        let mut t0 = [0.0; 3];
+        let mut t1 = [0.0; 3];
+        for a in 0..3 {
+            let (mut o, mut d) = (ray.origin[a], ray.direction[a]);
+            if d < 0.0 {
+                (o, d) = (lo[a] + hi[a] - o, -d);
+                flip |= 1 << a;
+            }
+            let inv = 1.0 / d.max(1e-200);
+            t0[a] = (lo[a] - o) * inv;
+            t1[a] = (hi[a] - o) * inv;
+        }
+        let mut mailbox = None;
         // Uninitialised: only entries below `top`, all written first, are read.
-        let mut stack = [MaybeUninit::<(u32, Vec3, Vec3, f64, f64)>::uninit(); STACK];
-        stack[0].write((0, self.bounds.min, self.bounds.max, t_enter, t_exit));
+        let mut stack = [MaybeUninit::<(u32, [f64; 3], [f64; 3])>::uninit(); STACK];
+        stack[0].write((0, t0, t1));
         let mut top = 1;
         while top > 0 {
             top -= 1;
             // SAFETY: entries below `top` were written when pushed.
-            let (index, lo, hi, ta, tb) = unsafe { stack[top].assume_init() };
-            if ta > t_max {
+            let (index, t0, t1) = unsafe { stack[top].assume_init() };
+            let enter = t0[0].max(t0[1]).max(t0[2]);
+            let leave = t1[0].min(t1[1]).min(t1[2]);
+            if enter > t_max || leave < 0.0 || enter > leave {
                 continue;
             }
-            let node = &self.nodes[index as usize];
-            if node.first_child == 0 {
-                let start = node.start as usize;
-                let items = &self.items[start..start + node.count as usize];
+            let node = self.node(index as usize);
+            if node.info & LEAF != 0 {
+                let start = node.first as usize;
+                let items = &self.items[start..start + (node.info & !LEAF) as usize];
+                let mailbox =
+                    mailbox.get_or_insert_with(|| Mailbox::start(self.owner, self.item_count));
                 if !mailbox.visit_untested(items, &mut t_max, &mut visit) {
                     return;
                 }
                 continue;
             }
-            let mid = (lo + hi) * 0.5;
-            let tm = [0, 1, 2].map(|a| (mid[a] - ray.origin[a]) * inv[a]);
-            // The child the ray is in at ta: on the upper side of a mid-plane it has already
-            // crossed going up, or not yet crossed going down.
+            let mut mid = [0.0; 3];
+            for a in 0..3 {
+                mid[a] = 0.5 * (t0[a] + t1[a]);
+            }
+            // The child the ray enters first: upper along each axis whose mid-plane it
+            // crossed before entering. Then, until it leaves the cell, the next child is
+            // across the nearest of the current child's exit planes.
             let mut octant = 0;
             for a in 0..3 {
-                let upper = if inv[a] > 0.0 {
-                    tm[a] <= ta
-                } else {
-                    tm[a] > ta
-                };
-                octant |= (upper as usize) << a;
+                octant |= usize::from(mid[a] < enter) << a;
             }
-            // The mid-planes crossed inside the cell, in order along the ray.
-            let mut crossings = [(0.0f64, 0usize); 3];
+            let mut path = [0usize; 4];
             let mut n = 0;
-            for (a, &t) in tm.iter().enumerate() {
-                if t > ta && t < tb {
-                    crossings[n] = (t, a);
-                    n += 1;
+            loop {
+                path[n] = octant;
+                n += 1;
+                let mut exit = [0.0; 3];
+                for a in 0..3 {
+                    exit[a] = if octant >> a & 1 == 1 { t1[a] } else { mid[a] };
                 }
-            }
-            // At most three: sorted by exchanges, without a call into the general sort.
-            for i in 1..n {
-                let mut j = i;
-                while j > 0 && crossings[j].0 < crossings[j - 1].0 {
-                    crossings.swap(j, j - 1);
-                    j -= 1;
+                let a = nearest(exit);
+                if octant >> a & 1 == 1 || exit[a] > t_max {
+                    break;
                 }
+                octant |= 1 << a;
             }
-            // Children along the ray: push them farthest first so the nearest pops next.
-            let mut sequence = [(0usize, 0.0f64, 0.0f64); 4];
-            let mut t = ta;
-            for (k, &(tc, axis)) in crossings[..n].iter().enumerate() {
-                sequence[k] = (octant, t, tc);
-                octant ^= 1 << axis;
-                t = tc;
-            }
-            sequence[n] = (octant, t, tb);
-            for &(oct, t0, t1) in sequence[..=n].iter().rev() {
-                let child = &self.nodes[(node.first_child + oct as u32) as usize];
-                if child.first_child == 0 && child.count == 0 {
-                    // An empty leaf: nothing to visit there.
+            // Farthest pushed first, so the nearest pops next.
+            for &octant in path[..n].iter().rev() {
+                if node.info >> (octant ^ flip) & 1 == 0 {
                     continue;
                 }
-                let (clo, chi) = child_box(lo, hi, oct);
-                stack[top].write((node.first_child + oct as u32, clo, chi, t0, t1));
+                let child = node.first * 8 + (octant ^ flip) as u32;
+                let (mut c0, mut c1) = (t0, t1);
+                for a in 0..3 {
+                    if octant >> a & 1 == 1 {
+                        c0[a] = mid[a];
+                    } else {
+                        c1[a] = mid[a];
+                    }
+                }
+                stack[top].write((child, c0, c1));
                 top += 1;
             }
         }
