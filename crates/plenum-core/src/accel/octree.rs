@@ -12,6 +12,8 @@ use std::mem::MaybeUninit;
 
 const LEAF_ITEMS: usize = 8;
 const MAX_DEPTH: usize = 16;
+/// Visiting a cell's children, in item tests.
+const SPLIT_COST: usize = 8;
 /// A ray passes through at most four of a cell's children.
 const STACK: usize = 3 * MAX_DEPTH + 2;
 
@@ -129,9 +131,12 @@ impl Octree {
                 }
             }
         }
-        // Items that mostly straddle the centre: splitting would only copy them.
+        // A ray through the cell crosses each child with probability ¼ (their surface area
+        // to the cell's), so after the split it tests about a quarter of the copies, and
+        // pays for visiting the children. Items that mostly straddle the centre make the
+        // split cost more than it saves.
         let copies: usize = children.iter().map(Vec::len).sum();
-        if copies > 2 * items.len() || children.iter().all(|c| c.len() == items.len()) {
+        if copies + 4 * SPLIT_COST >= 4 * items.len() {
             return make_leaf(self, &items);
         }
         let block = self.blocks.len();
