@@ -184,23 +184,61 @@ proptest! {
         polygons in prop::collection::vec(polygon(), 0..30),
         rays in rays(),
     ) {
-        let oracle = scene_of(&spheres, &polygons, AccelKind::None);
-        // Rays that start on a sphere.
-        let mut all = rays.clone();
-        for (&(c, r), ray) in spheres.iter().zip(&rays) {
-            all.push(Ray::new(c + ray.direction.normalized() * r, ray.direction));
-        }
-        for kind in FAST {
-            let scene = scene_of(&spheres, &polygons, kind);
-            prop_assert_eq!(scene.accel_kind(), kind);
-            for ray in &all {
-                let want = oracle.intersect(ray, f64::INFINITY).map(|(p, h)| (p, h.t));
-                let got = scene.intersect(ray, f64::INFINITY).map(|(p, h)| (p, h.t));
-                agree(got, want).map_err(|e| TestCaseError::fail(format!("{kind}: {e}")))?;
-                prop_assert_eq!(scene.occluded(ray, f64::INFINITY), got.is_some());
-            }
+        check_scene(&spheres, &polygons, &rays)?;
+    }
+
+    /// A small model under and beside polygons as large as the scene: the grid and the
+    /// octree test those on every ray instead of filing them.
+    #[test]
+    fn model_in_a_stadium_agrees(
+        spheres in prop::collection::vec((vec3(2.0), 0.01..0.5f64), 10..60),
+        walls in prop::collection::vec((vec3(3.0), direction(), 30.0..60.0f64), 1..4),
+        triangles in prop::collection::vec(triangle(), 1..60),
+        rays in rays(),
+    ) {
+        let walls: Vec<Vec<Vec3>> = walls
+            .iter()
+            .map(|&(c, n, r)| {
+                let n = n.normalized();
+                let u = if n.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
+                let u = (u - n * n.dot(u)).normalized();
+                let v = n.cross(u);
+                vec![c + u * r, c + v * r, c - u * r, c - v * r]
+            })
+            .collect();
+        check_scene(&spheres, &walls, &rays)?;
+        // The same in a mesh: triangles with two as large as the scene.
+        let mut soup: Vec<[Vec3; 3]> = triangles.iter().map(|t| t.map(|p| p * 0.2)).collect();
+        soup.push([Vec3::new(-50.0, -1.0, -50.0), Vec3::new(50.0, -1.0, -50.0), Vec3::new(0.0, -1.0, 50.0)]);
+        soup.push([Vec3::new(-50.0, -50.0, 2.0), Vec3::new(50.0, -50.0, 2.0), Vec3::new(0.0, 50.0, 2.5)]);
+        check_mesh(&soup, &rays)?;
+    }
+}
+
+/// Every structure finds brute force's closest hit among spheres and polygons, and any-hit
+/// agrees about occlusion, on the rays given and on rays that start on a sphere.
+fn check_scene(
+    spheres: &[(Vec3, f64)],
+    polygons: &[Vec<Vec3>],
+    rays: &[Ray],
+) -> Result<(), TestCaseError> {
+    let oracle = scene_of(spheres, polygons, AccelKind::None);
+    // Rays that start on a sphere.
+    let mut all = rays.to_vec();
+    for (&(c, r), ray) in spheres.iter().zip(rays) {
+        all.push(Ray::new(c + ray.direction.normalized() * r, ray.direction));
+    }
+    for kind in FAST {
+        let scene = scene_of(spheres, polygons, kind);
+        prop_assert_eq!(scene.accel_kind(), kind);
+        for ray in &all {
+            let want = oracle.intersect(ray, f64::INFINITY).map(|(p, h)| (p, h.t));
+            let got = scene.intersect(ray, f64::INFINITY).map(|(p, h)| (p, h.t));
+            agree(got, want).map_err(|e| TestCaseError::fail(format!("{kind}: {e}")))?;
+            prop_assert_eq!(scene.occluded(ray, f64::INFINITY), got.is_some());
         }
     }
+    Ok(())
 }
 
 proptest! {

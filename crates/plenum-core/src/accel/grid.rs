@@ -9,7 +9,7 @@
 //! the cells the ray touches up to rounding, which the margin items are filed with covers.
 
 use super::mailbox::{new_owner, Mailbox};
-use super::nearest;
+use super::{nearest, split_off_large};
 use crate::math::{Bounds3, Ray, Vec3};
 
 /// Cells per item.
@@ -20,7 +20,12 @@ const MACRO: usize = 4;
 
 #[derive(Clone, Debug)]
 pub struct Grid {
+    /// The cells' region: the bounds of the items in them.
     bounds: Bounds3,
+    /// The bounds of all the items, large ones included.
+    all_bounds: Bounds3,
+    /// Items as large as the scene, tested by every ray (see [`split_off_large`]).
+    large: Vec<u32>,
     resolution: [usize; 3],
     cell_size: Vec3,
     /// Items of cell c are `items[starts[c]..starts[c + 1]]`.
@@ -35,14 +40,18 @@ pub struct Grid {
 
 impl Grid {
     pub fn build(item_bounds: &[Bounds3]) -> Grid {
-        let bounded: Vec<usize> = (0..item_bounds.len())
-            .filter(|&i| !item_bounds[i].is_empty())
-            .collect();
-        let bounds = bounded
-            .iter()
-            .fold(Bounds3::default(), |b, &i| b.union(&item_bounds[i]));
+        let (bounded, large) = split_off_large(item_bounds);
+        let union = |items: &[u32]| {
+            items.iter().fold(Bounds3::default(), |b, &i| {
+                b.union(&item_bounds[i as usize])
+            })
+        };
+        let bounds = union(&bounded);
+        let all_bounds = bounds.union(&union(&large));
         let mut grid = Grid {
             bounds,
+            all_bounds,
+            large,
             resolution: [1; 3],
             cell_size: Vec3::ONE,
             starts: vec![0, 0],
@@ -79,7 +88,7 @@ impl Grid {
         // Items are filed by their boxes grown a little, so that rounding in the cell
         // arithmetic can never leave an item out of a cell the ray meets it in.
         let margin = longest * 1e-9;
-        let filed = |i: usize| item_bounds[i].expanded(margin);
+        let filed = |i: u32| item_bounds[i as usize].expanded(margin);
         let mut counts = vec![0u32; cell_count + 1];
         for &i in &bounded {
             grid.for_cells(&filed(i), |c| counts[c] += 1);
@@ -94,7 +103,7 @@ impl Grid {
         let mut items = vec![0u32; total as usize];
         for &i in &bounded {
             grid.for_cells(&filed(i), |c| {
-                items[fill[c] as usize] = i as u32;
+                items[fill[c] as usize] = i;
                 fill[c] += 1;
             });
         }
@@ -114,7 +123,7 @@ impl Grid {
     }
 
     pub fn bounds(&self) -> Bounds3 {
-        self.bounds
+        self.all_bounds
     }
 
     pub fn resolution(&self) -> [usize; 3] {
@@ -122,7 +131,7 @@ impl Grid {
     }
 
     pub fn memory_bytes(&self) -> usize {
-        (self.starts.len() + self.items.len()) * 4 + self.macro_full.len()
+        (self.starts.len() + self.items.len() + self.large.len()) * 4 + self.macro_full.len()
     }
 
     /// The cell of a point along one axis, clamped to the grid.
@@ -156,6 +165,11 @@ impl Grid {
     /// Two walks in step: one over macro cells, which crosses an empty one in a single step,
     /// and one over the cells of each macro cell that holds anything.
     pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
+        let mut t_max = t_max;
+        // First, so that a hit on them (the ground, say) prunes the walk.
+        if !self.large.is_empty() && !visit(&self.large, &mut t_max) {
+            return;
+        }
         if self.items.is_empty() {
             return;
         }
@@ -164,7 +178,6 @@ impl Grid {
         };
         let walk = Walk::new(self, ray);
         let mut limit = t_max.min(t_exit);
-        let mut t_max = t_max;
         let p = ray.at(t_enter);
         let mut cell = [0; 3];
         for a in 0..3 {

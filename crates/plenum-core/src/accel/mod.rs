@@ -23,6 +23,35 @@ pub use octree::Octree;
 
 use crate::math::{Bounds3, Ray};
 
+/// An item whose box has more than this share of the scene box's surface area is large.
+const LARGE_SHARE: f64 = 0.25;
+/// Most large items a spatial subdivision keeps out of its cells.
+const MAX_LARGE: usize = 16;
+
+/// For the grid and the octree: the items with a box, split into those to file in cells and
+/// a few as large as the scene (a ground polygon under a small model, the walls of a room),
+/// which every ray tests instead. Filed, they would stretch the cells over empty space and
+/// leave the model few of them ("the teapot in a stadium"), and be tested in every cell the
+/// ray crosses anyway. Many large items stay filed: testing them all per ray would be brute
+/// force.
+fn split_off_large(item_bounds: &[Bounds3]) -> (Vec<u32>, Vec<u32>) {
+    let bounded: Vec<u32> = (0..item_bounds.len() as u32)
+        .filter(|&i| !item_bounds[i as usize].is_empty())
+        .collect();
+    let scene = bounded.iter().fold(Bounds3::default(), |b, &i| {
+        b.union(&item_bounds[i as usize])
+    });
+    let threshold = LARGE_SHARE * scene.surface_area();
+    let (large, filed): (Vec<u32>, Vec<u32>) = bounded
+        .iter()
+        .partition(|&&i| item_bounds[i as usize].surface_area() > threshold);
+    if large.len() <= MAX_LARGE && !filed.is_empty() {
+        (filed, large)
+    } else {
+        (bounded, Vec::new())
+    }
+}
+
 /// Which acceleration structure to build.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum AccelKind {
@@ -167,5 +196,35 @@ fn nearest(t: [f64; 3]) -> usize {
         1
     } else {
         2
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+
+    fn cube(center: Vec3, half: f64) -> Bounds3 {
+        Bounds3::new(center - Vec3::ONE * half, center + Vec3::ONE * half)
+    }
+
+    #[test]
+    fn a_ground_under_a_model_is_split_off_and_many_large_items_are_not() {
+        let ground = Bounds3::new(Vec3::new(-12.0, 0.0, -12.0), Vec3::new(12.0, 0.0, 12.0));
+        let mut items: Vec<Bounds3> = (0..20)
+            .map(|i| cube(Vec3::new(i as f64 * 0.1, 1.0, 0.0), 0.05))
+            .collect();
+        items.push(ground);
+        items.push(Bounds3::default());
+        let (filed, large) = split_off_large(&items);
+        assert_eq!(large, vec![20]);
+        assert_eq!(filed, (0..20).collect::<Vec<u32>>());
+        // Nothing but large items: they stay filed.
+        let (filed, large) = split_off_large(&[ground, ground]);
+        assert_eq!((filed, large), (vec![0, 1], vec![]));
+        // More large items than are worth testing on every ray.
+        let walls = vec![ground; MAX_LARGE + 1];
+        let (filed, large) = split_off_large(&[walls, vec![cube(Vec3::ZERO, 0.1)]].concat());
+        assert_eq!((filed.len(), large.len()), (MAX_LARGE + 2, 0));
     }
 }

@@ -6,7 +6,7 @@
 //! visited front to back. Items filed in several cells are mailboxed.
 
 use super::mailbox::{new_owner, Mailbox};
-use super::nearest;
+use super::{nearest, split_off_large};
 use crate::math::{Bounds3, Ray, Vec3};
 use std::mem::MaybeUninit;
 
@@ -43,7 +43,12 @@ const EMPTY_BLOCK: Siblings = Siblings(
 
 #[derive(Clone, Debug)]
 pub struct Octree {
+    /// The root cell: the bounds of the items filed in cells.
     bounds: Bounds3,
+    /// The bounds of all the items, large ones included.
+    all_bounds: Bounds3,
+    /// Items as large as the scene, tested by every ray (see [`split_off_large`]).
+    large: Vec<u32>,
     /// Cell `id` is `blocks[id / 8].0[id % 8]`; the root is cell 0, alone in its block.
     blocks: Vec<Siblings>,
     items: Vec<u32>,
@@ -71,14 +76,17 @@ fn child_box(lo: Vec3, hi: Vec3, octant: usize) -> (Vec3, Vec3) {
 
 impl Octree {
     pub fn build(item_bounds: &[Bounds3]) -> Octree {
-        let bounded: Vec<u32> = (0..item_bounds.len() as u32)
-            .filter(|&i| !item_bounds[i as usize].is_empty())
-            .collect();
-        let bounds = bounded.iter().fold(Bounds3::default(), |b, &i| {
-            b.union(&item_bounds[i as usize])
-        });
+        let (bounded, large) = split_off_large(item_bounds);
+        let union = |items: &[u32]| {
+            items.iter().fold(Bounds3::default(), |b, &i| {
+                b.union(&item_bounds[i as usize])
+            })
+        };
+        let bounds = union(&bounded);
         let mut tree = Octree {
             bounds,
+            all_bounds: bounds.union(&union(&large)),
+            large,
             blocks: vec![EMPTY_BLOCK],
             items: Vec::new(),
             item_count: item_bounds.len(),
@@ -163,20 +171,25 @@ impl Octree {
     }
 
     pub fn bounds(&self) -> Bounds3 {
-        self.bounds
+        self.all_bounds
     }
 
     pub fn memory_bytes(&self) -> usize {
-        self.blocks.len() * std::mem::size_of::<Siblings>() + self.items.len() * 4
+        self.blocks.len() * std::mem::size_of::<Siblings>()
+            + (self.items.len() + self.large.len()) * 4
     }
 
     /// Visits the leaves the ray crosses front to back, handing `visit` their untested items
     /// (see [`super::Accel::traverse`]).
     pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
+        let mut t_max = t_max;
+        // First, so that a hit on them (the ground, say) prunes the descent.
+        if !self.large.is_empty() && !visit(&self.large, &mut t_max) {
+            return;
+        }
         if self.items.is_empty() || self.bounds.intersect_interval(ray, t_max).is_none() {
             return;
         }
-        let mut t_max = t_max;
         // As Revelles et al. do, mirror the ray about the tree's centre along each axis it
         // runs down, so that it runs up every axis; octant bits in `flip` undo the mirroring.
         // A zero direction component becomes a tiny positive one: its planes are then
