@@ -164,7 +164,29 @@ impl Grid {
     ///
     /// Two walks in step: one over macro cells, which crosses an empty one in a single step,
     /// and one over the cells of each macro cell that holds anything.
-    pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
+    pub fn traverse(&self, ray: &Ray, t_max: f64, visit: impl FnMut(&[u32], &mut f64) -> bool) {
+        self.walk::<true>(ray, t_max, visit);
+    }
+
+    /// [`Grid::traverse`] without mailboxing: an item in several cells may be handed over
+    /// again, which costs less than the stamps where testing it again is cheap and harmless
+    /// (a mesh's triangles, for the nearest or any hit).
+    pub fn traverse_repeating(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        visit: impl FnMut(&[u32], &mut f64) -> bool,
+    ) {
+        self.walk::<false>(ray, t_max, visit);
+    }
+
+    #[inline(always)]
+    fn walk<const UNIQUE: bool>(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        mut visit: impl FnMut(&[u32], &mut f64) -> bool,
+    ) {
         let mut t_max = t_max;
         // First, so that a hit on them (the ground, say) prunes the walk.
         if !self.large.is_empty() && !visit(&self.large, &mut t_max) {
@@ -204,10 +226,15 @@ impl Grid {
                 let a = loop {
                     let (first, end) = (self.starts[c] as usize, self.starts[c + 1] as usize);
                     if first < end {
-                        let mailbox = mailbox
-                            .get_or_insert_with(|| Mailbox::start(self.owner, self.item_count));
-                        if !mailbox.visit_untested(&self.items[first..end], &mut t_max, &mut visit)
-                        {
+                        let items = &self.items[first..end];
+                        let go_on = if UNIQUE {
+                            mailbox
+                                .get_or_insert_with(|| Mailbox::start(self.owner, self.item_count))
+                                .visit_untested(items, &mut t_max, &mut visit)
+                        } else {
+                            visit(items, &mut t_max)
+                        };
+                        if !go_on {
                             return;
                         }
                         limit = t_max.min(t_exit);

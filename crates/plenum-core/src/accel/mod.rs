@@ -182,6 +182,24 @@ impl Accel {
             Accel::None(a) => a.traverse(ray, t_max, visit),
         }
     }
+
+    /// [`Accel::traverse`] for a caller to whom an item handed over twice costs little and
+    /// changes nothing, such as a nearest- or any-hit query over triangles: the grid and the
+    /// octree then skip mailboxing, which costs more than the repeated tests it saves.
+    #[inline]
+    pub fn traverse_repeating(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        visit: impl FnMut(&[u32], &mut f64) -> bool,
+    ) {
+        match self {
+            Accel::Bvh(a) => a.traverse(ray, t_max, visit),
+            Accel::Grid(a) => a.traverse_repeating(ray, t_max, visit),
+            Accel::Octree(a) => a.traverse_repeating(ray, t_max, visit),
+            Accel::None(a) => a.traverse(ray, t_max, visit),
+        }
+    }
 }
 
 /// The axis of the smallest of three times (the grid's and the octree's next wall).

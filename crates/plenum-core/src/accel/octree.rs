@@ -181,7 +181,29 @@ impl Octree {
 
     /// Visits the leaves the ray crosses front to back, handing `visit` their untested items
     /// (see [`super::Accel::traverse`]).
-    pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
+    pub fn traverse(&self, ray: &Ray, t_max: f64, visit: impl FnMut(&[u32], &mut f64) -> bool) {
+        self.descend::<true>(ray, t_max, visit);
+    }
+
+    /// [`Octree::traverse`] without mailboxing: an item in several cells may be handed over
+    /// again, which costs less than the stamps where testing it again is cheap and harmless
+    /// (a mesh's triangles, for the nearest or any hit).
+    pub fn traverse_repeating(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        visit: impl FnMut(&[u32], &mut f64) -> bool,
+    ) {
+        self.descend::<false>(ray, t_max, visit);
+    }
+
+    #[inline(always)]
+    fn descend<const UNIQUE: bool>(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        mut visit: impl FnMut(&[u32], &mut f64) -> bool,
+    ) {
         let mut t_max = t_max;
         // First, so that a hit on them (the ground, say) prunes the descent.
         if !self.large.is_empty() && !visit(&self.large, &mut t_max) {
@@ -226,9 +248,14 @@ impl Octree {
             if node.info & LEAF != 0 {
                 let start = node.first as usize;
                 let items = &self.items[start..start + (node.info & !LEAF) as usize];
-                let mailbox =
-                    mailbox.get_or_insert_with(|| Mailbox::start(self.owner, self.item_count));
-                if !mailbox.visit_untested(items, &mut t_max, &mut visit) {
+                let go_on = if UNIQUE {
+                    mailbox
+                        .get_or_insert_with(|| Mailbox::start(self.owner, self.item_count))
+                        .visit_untested(items, &mut t_max, &mut visit)
+                } else {
+                    visit(items, &mut t_max)
+                };
+                if !go_on {
                     return;
                 }
                 continue;

@@ -323,7 +323,8 @@ impl TriangleMesh {
             }
             return;
         }
-        self.accel.traverse(ray, t_max, |items, t_max| {
+        // A triangle met again in another cell is simply tested again: no stamps needed.
+        self.accel.traverse_repeating(ray, t_max, |items, t_max| {
             for block in items.chunks(4) {
                 let last = block.len() - 1;
                 let ids = [0, 1, 2, 3].map(|lane| block[lane.min(last)]);
