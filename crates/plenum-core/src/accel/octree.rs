@@ -239,8 +239,12 @@ impl Octree {
             top -= 1;
             // SAFETY: entries below `top` were written when pushed.
             let (index, t0, t1) = unsafe { stack[top].assume_init() };
-            let enter = t0[0].max(t0[1]).max(t0[2]);
-            let leave = t1[0].min(t1[1]).min(t1[2]);
+            // Plain comparisons: the distances are never NaN, so f64::max's NaN rules would
+            // only cost instructions.
+            let larger = |a: f64, b: f64| if a > b { a } else { b };
+            let smaller = |a: f64, b: f64| if a < b { a } else { b };
+            let enter = larger(larger(t0[0], t0[1]), t0[2]);
+            let leave = smaller(smaller(t1[0], t1[1]), t1[2]);
             if enter > t_max || leave < 0.0 || enter > leave {
                 continue;
             }
