@@ -317,9 +317,9 @@ impl TriangleMesh {
                 true
             };
             if NEAREST_FIRST {
-                bvh.traverse_runs(ray, t_max, visit_run);
+                bvh.traverse_runs(ray, t_max, &self.triangles, visit_run);
             } else {
-                bvh.traverse_runs_any_order(ray, t_max, visit_run);
+                bvh.traverse_runs_any_order(ray, t_max, &self.triangles, visit_run);
             }
             return;
         }
