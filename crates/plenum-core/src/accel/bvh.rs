@@ -226,7 +226,10 @@ impl Bvh {
             let p = if child & LEAF_BIT == 0 {
                 self.nodes.as_ptr().wrapping_add(child as usize) as *const i8
             } else {
-                items.base.wrapping_add((child & START_MASK) as usize * items.stride) as *const i8
+                items
+                    .base
+                    .wrapping_add((child & START_MASK) as usize * items.stride)
+                    as *const i8
             };
             let lines = if child & LEAF_BIT == 0 { 4 } else { 2 };
             // SAFETY: prefetching is only a hint; it never faults, so the address needs no
@@ -247,7 +250,9 @@ impl Bvh {
     /// and returns false to stop.
     #[inline]
     pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
-        self.traverse_runs(ray, t_max, &self.order, |run, t_max| visit(&self.order[run], t_max));
+        self.traverse_runs(ray, t_max, &self.order, |run, t_max| {
+            visit(&self.order[run], t_max)
+        });
     }
 
     /// Hands the caller the items in leaf order and leaves the BVH without them: for a caller

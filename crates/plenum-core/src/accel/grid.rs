@@ -28,6 +28,8 @@ pub struct Grid {
     large: Vec<u32>,
     resolution: [usize; 3],
     cell_size: Vec3,
+    /// 1 / cell_size, or 0 along a flat axis: cells are found by a product, not a quotient.
+    inv_cell_size: Vec3,
     /// Items of cell c are `items[starts[c]..starts[c + 1]]`.
     starts: Vec<u32>,
     items: Vec<u32>,
@@ -54,6 +56,7 @@ impl Grid {
             large,
             resolution: [1; 3],
             cell_size: Vec3::ONE,
+            inv_cell_size: Vec3::ONE,
             starts: vec![0, 0],
             items: Vec::new(),
             macro_full: vec![true],
@@ -82,6 +85,12 @@ impl Grid {
             extent.x / grid.resolution[0] as f64,
             extent.y / grid.resolution[1] as f64,
             extent.z / grid.resolution[2] as f64,
+        );
+        let inverse = |size: f64| if size > 0.0 { 1.0 / size } else { 0.0 };
+        grid.inv_cell_size = Vec3::new(
+            inverse(grid.cell_size.x),
+            inverse(grid.cell_size.y),
+            inverse(grid.cell_size.z),
         );
         let cell_count = grid.resolution.iter().product::<usize>();
         // Two passes: count each cell's items, then file them (compressed rows).
@@ -136,13 +145,12 @@ impl Grid {
 
     /// The cell of a point along one axis, clamped to the grid.
     fn cell_of(&self, x: f64, axis: usize) -> usize {
-        let size = self.cell_size[axis];
-        if size <= 0.0 {
+        if self.cell_size[axis] <= 0.0 {
             return 0;
         }
         // Truncation is floor here (c ≥ 0), without a call into libm; a signed conversion
         // is one instruction, and the clamp keeps it in range.
-        let c = (x - self.bounds.min[axis]) / size;
+        let c = (x - self.bounds.min[axis]) * self.inv_cell_size[axis];
         (c.min(MAX_RESOLUTION as f64) as i64).clamp(0, self.resolution[axis] as i64 - 1) as usize
     }
 
@@ -195,10 +203,10 @@ impl Grid {
         if self.items.is_empty() {
             return;
         }
-        let Some((t_enter, t_exit)) = self.bounds.intersect_interval(ray, t_max) else {
+        let walk = Walk::new(self, ray);
+        let Some((t_enter, t_exit)) = self.bounds.intersect(ray, walk.inv_dir, t_max) else {
             return;
         };
-        let walk = Walk::new(self, ray);
         let mut limit = t_max.min(t_exit);
         let p = ray.at(t_enter);
         let mut cell = [0; 3];
@@ -239,17 +247,39 @@ impl Grid {
                         }
                         limit = t_max.min(t_exit);
                     }
+                    // One step across the nearest wall, by selects over fixed indices:
+                    // indexing by the axis would keep the walk's state in memory, a chain
+                    // of stores and reloads from one step to the next.
                     let a = nearest(next);
-                    if next[a] > limit {
+                    let smaller = |x: f64, y: f64| if x < y { x } else { y };
+                    if smaller(smaller(next[0], next[1]), next[2]) > limit {
                         return;
                     }
-                    cell[a] = cell[a].wrapping_add_signed(walk.step[a]);
-                    if cell[a] >= self.resolution[a] {
+                    for i in 0..3 {
+                        let on = a == i;
+                        cell[i] = if on {
+                            cell[i].wrapping_add_signed(walk.step[i])
+                        } else {
+                            cell[i]
+                        };
+                        next[i] = if on { next[i] + walk.delta[i] } else { next[i] };
+                        c = if on {
+                            c.wrapping_add_signed(walk.stride[i])
+                        } else {
+                            c
+                        };
+                    }
+                    // Below zero wraps to beyond the grid.
+                    let outside = (cell[0] >= self.resolution[0])
+                        | (cell[1] >= self.resolution[1])
+                        | (cell[2] >= self.resolution[2]);
+                    if outside {
                         return;
                     }
-                    c = c.wrapping_add_signed(walk.stride[a]);
-                    next[a] += walk.delta[a];
-                    if cell[a] / MACRO != block[a] {
+                    let left = (cell[0] / MACRO != block[0])
+                        | (cell[1] / MACRO != block[1])
+                        | (cell[2] / MACRO != block[2]);
+                    if left {
                         break a;
                     }
                 };
@@ -322,18 +352,20 @@ impl Walk {
         let [nx, ny, _] = grid.resolution;
         let d = ray.direction;
         let step = [0, 1, 2].map(|a| (d[a] > 0.0) as isize - (d[a] < 0.0) as isize);
+        // The only divisions per ray.
+        let inv_dir = Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
         let [mx, my, _] = grid.macro_resolution;
         let strides = [1, nx as isize, (nx * ny) as isize];
         let macro_strides = [1, mx as isize, (mx * my) as isize];
         Walk {
             origin: ray.origin,
-            inv_dir: Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z),
+            inv_dir,
             step,
             stride: [0, 1, 2].map(|a| step[a] * strides[a]),
             macro_stride: [0, 1, 2].map(|a| step[a] * macro_strides[a]),
             delta: [0, 1, 2].map(|a| match step[a] {
                 0 => f64::INFINITY,
-                _ => (grid.cell_size[a] / d[a]).abs(),
+                _ => (grid.cell_size[a] * inv_dir[a]).abs(),
             }),
         }
     }

@@ -209,7 +209,8 @@ impl Octree {
         if !self.large.is_empty() && !visit(&self.large, &mut t_max) {
             return;
         }
-        if self.items.is_empty() || self.bounds.intersect_interval(ray, t_max).is_none() {
+        // The root's own entry and exit test below stands for a test of the bounds.
+        if self.items.is_empty() {
             return;
         }
         // As Revelles et al. do, mirror the ray about the tree's centre along each axis it
