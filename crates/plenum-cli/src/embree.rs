@@ -111,7 +111,7 @@ impl EmbreeMesh {
             let scene = rtcNewScene(device);
             rtcSetSceneBuildQuality(scene, BUILD_QUALITY_HIGH);
             let geometry = rtcNewGeometry(device, GEOMETRY_TYPE_TRIANGLE);
-            let positions = mesh.positions();
+            let positions: Vec<_> = mesh.positions().collect();
             let vertices = rtcSetNewGeometryBuffer(
                 geometry,
                 BUFFER_TYPE_VERTEX,

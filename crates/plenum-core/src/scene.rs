@@ -468,7 +468,7 @@ impl SceneBuilder {
         let triangles = mesh
             .triangles()
             .iter()
-            .map(|t| t.map(|i| to_world.point(mesh.positions()[i as usize])))
+            .map(|t| t.map(|i| to_world.point(mesh.position(i))))
             .collect();
         let material = self.add_material(format!("{name} (emitter)"), Material::emitter(radiance));
         self.add_object(name.clone(), Shape::Mesh(mesh), to_world, material);

@@ -341,7 +341,7 @@ fn texture(t: &Texture) -> String {
 fn mesh_arrays(m: &plenum_core::geometry::TriangleMesh) -> String {
     let mut s = format!(
         "positions = {}\nindices = [{}]",
-        points(m.positions()),
+        points(&m.positions().collect::<Vec<_>>()),
         m.triangles()
             .iter()
             .map(|t| format!("[{}, {}, {}]", t[0], t[1], t[2]))

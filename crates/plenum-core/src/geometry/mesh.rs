@@ -20,9 +20,8 @@ const LEAF: LeafSize = LeafSize {
 
 #[derive(Clone, Debug)]
 pub struct TriangleMesh {
-    /// Positions, each coordinate exactly an f32 (the geometry the f32 test sees).
-    positions: Vec<Vec3>,
-    /// The same positions packed for the SIMD test (the fourth lane is padding).
+    /// Positions in f32, the geometry the SIMD test sees, padded to four lanes; they are
+    /// the mesh's only copy (shading widens them to f64, exactly).
     packed: Vec<[f32; 4]>,
     /// Per-vertex shading normals, or empty for flat shading.
     normals: Vec<Vec3>,
@@ -108,6 +107,7 @@ impl TriangleMesh {
                 });
             }
         }
+        // Each coordinate rounded to f32, as it is stored.
         let positions: Vec<Vec3> = positions
             .iter()
             .map(|p| Vec3::new(p.x as f32 as f64, p.y as f32 as f64, p.z as f32 as f64))
@@ -122,7 +122,6 @@ impl TriangleMesh {
         let closed = is_closed(&positions, &triangles);
         let mut mesh = TriangleMesh {
             bounds: Bounds3::from_points(positions.iter().copied()),
-            positions,
             packed,
             normals,
             uvs,
@@ -164,8 +163,8 @@ impl TriangleMesh {
     /// of a leaf's triangles share a few cache lines instead of scattering over the mesh.
     fn number_vertices_by_first_use(&mut self) {
         const UNSEEN: u32 = u32::MAX;
-        let mut new_index = vec![UNSEEN; self.positions.len()];
-        let mut old_index = Vec::with_capacity(self.positions.len());
+        let mut new_index = vec![UNSEEN; self.packed.len()];
+        let mut old_index = Vec::with_capacity(self.packed.len());
         for v in self.triangles.iter_mut().flatten() {
             if new_index[*v as usize] == UNSEEN {
                 new_index[*v as usize] = old_index.len() as u32;
@@ -175,13 +174,12 @@ impl TriangleMesh {
         }
         // Vertices no triangle uses keep their place after the others.
         old_index
-            .extend((0..self.positions.len() as u32).filter(|&v| new_index[v as usize] == UNSEEN));
+            .extend((0..self.packed.len() as u32).filter(|&v| new_index[v as usize] == UNSEEN));
         fn permute<T: Copy>(values: &mut Vec<T>, old_index: &[u32]) {
             if !values.is_empty() {
                 *values = old_index.iter().map(|&v| values[v as usize]).collect();
             }
         }
-        permute(&mut self.positions, &old_index);
         permute(&mut self.packed, &old_index);
         permute(&mut self.normals, &old_index);
         permute(&mut self.uvs, &old_index);
@@ -189,7 +187,6 @@ impl TriangleMesh {
 
     fn clone_without_accel(&self) -> TriangleMesh {
         TriangleMesh {
-            positions: self.positions.clone(),
             packed: self.packed.clone(),
             normals: self.normals.clone(),
             uvs: self.uvs.clone(),
@@ -204,14 +201,13 @@ impl TriangleMesh {
     fn triangle_bounds(&self) -> Vec<Bounds3> {
         self.triangles
             .iter()
-            .map(|t| Bounds3::from_points(t.iter().map(|&i| self.positions[i as usize])))
+            .map(|t| Bounds3::from_points(t.iter().map(|&i| self.position(i))))
             .collect()
     }
 
     /// Bytes the mesh occupies: vertices, indices, attributes and the acceleration structure.
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of::<TriangleMesh>()
-            + self.positions.len() * std::mem::size_of::<Vec3>()
             + self.packed.len() * std::mem::size_of::<[f32; 4]>()
             + self.normals.len() * std::mem::size_of::<Vec3>()
             + self.uvs.len() * std::mem::size_of::<[f64; 2]>()
@@ -229,11 +225,18 @@ impl TriangleMesh {
     }
 
     pub fn vertex_count(&self) -> usize {
-        self.positions.len()
+        self.packed.len()
     }
 
-    pub fn positions(&self) -> &[Vec3] {
-        &self.positions
+    /// The position of vertex `vertex`.
+    pub fn position(&self, vertex: u32) -> Vec3 {
+        let [x, y, z, _] = self.packed[vertex as usize];
+        Vec3::new(x as f64, y as f64, z as f64)
+    }
+
+    /// The positions of all vertices, in the mesh's numbering.
+    pub fn positions(&self) -> impl ExactSizeIterator<Item = Vec3> + '_ {
+        (0..self.packed.len() as u32).map(|v| self.position(v))
     }
 
     /// Per-vertex shading normals; empty when the mesh is flat-shaded.
@@ -262,7 +265,7 @@ impl TriangleMesh {
     }
 
     fn vertices(&self, index: u32) -> [Vec3; 3] {
-        self.triangles[index as usize].map(|i| self.positions[i as usize])
+        self.triangles[index as usize].map(|i| self.position(i))
     }
 
     /// The nearest hit in (0, t_max).
