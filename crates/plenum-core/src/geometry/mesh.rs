@@ -527,17 +527,20 @@ struct ShearedRay {
 impl ShearedRay {
     #[inline]
     fn new(ray: &Ray) -> ShearedRay {
+        // Arrays indexed through a table: a `Vec3` indexed by a variable axis branches.
+        const NEXT: [usize; 3] = [1, 2, 0];
         let kz = ray.direction.max_abs_axis();
-        let kx = (kz + 1) % 3;
-        let ky = (kx + 1) % 3;
-        let d = [kx, ky, kz].map(|a| ray.direction[a] as f32);
+        let (kx, ky) = (NEXT[kz], NEXT[NEXT[kz]]);
+        let (o, d) = (ray.origin, ray.direction);
+        let o = [o.x, o.y, o.z].map(|v| v as f32);
+        let d = [d.x, d.y, d.z].map(|v| v as f32);
         // The three quotients in one division.
-        let [sx, sy, sz, _] = F4::from_array([-d[0], -d[1], 1.0, 1.0])
-            .div(F4::splat(d[2]))
+        let [sx, sy, sz, _] = F4::from_array([-d[kx], -d[ky], 1.0, 1.0])
+            .div(F4::splat(d[kz]))
             .to_array();
         ShearedRay {
             axes: [kx, ky, kz],
-            origin: [kx, ky, kz].map(|a| F4::splat(ray.origin[a] as f32)),
+            origin: [kx, ky, kz].map(|a| F4::splat(o[a])),
             shear: [F4::splat(sx), F4::splat(sy), F4::splat(sz)],
         }
     }
