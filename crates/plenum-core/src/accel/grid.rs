@@ -250,9 +250,8 @@ impl Grid {
                     // One step across the nearest wall, by selects over fixed indices:
                     // indexing by the axis would keep the walk's state in memory, a chain
                     // of stores and reloads from one step to the next.
-                    let a = nearest(next);
-                    let smaller = |x: f64, y: f64| if x < y { x } else { y };
-                    if smaller(smaller(next[0], next[1]), next[2]) > limit {
+                    let (a, t) = nearest(next);
+                    if t > limit {
                         return;
                     }
                     for i in 0..3 {
@@ -288,8 +287,8 @@ impl Grid {
                 block_next[a] += walk.delta[a] * MACRO as f64;
                 m = m.wrapping_add_signed(walk.macro_stride[a]);
             } else {
-                let a = nearest(block_next);
-                if block_next[a] > limit {
+                let (a, t) = nearest(block_next);
+                if t > limit {
                     return;
                 }
                 block[a] = block[a].wrapping_add_signed(walk.step[a]);
@@ -297,7 +296,7 @@ impl Grid {
                     return;
                 }
                 m = m.wrapping_add_signed(walk.macro_stride[a]);
-                (t_block, entered_along) = (block_next[a], a);
+                (t_block, entered_along) = (t, a);
                 block_next[a] += walk.delta[a] * MACRO as f64;
                 walking = false;
             }

@@ -202,16 +202,17 @@ impl Accel {
     }
 }
 
-/// The axis of the smallest of three times (the grid's and the octree's next wall). Written
-/// as selects, not branches: which wall comes next is a coin toss the CPU cannot predict.
+/// The axis of the smallest of three times, and that time (the grid's and the octree's next
+/// wall). Written as selects, not branches: which wall comes next is a coin toss the CPU
+/// cannot predict.
 #[inline(always)]
-fn nearest(t: [f64; 3]) -> usize {
+fn nearest(t: [f64; 3]) -> (usize, f64) {
     let y_first = t[1] < t[0];
     let (axis, time) = if y_first { (1, t[1]) } else { (0, t[0]) };
     if t[2] < time {
-        2
+        (2, t[2])
     } else {
-        axis
+        (axis, time)
     }
 }
 
@@ -232,7 +233,9 @@ mod tests {
                 for &z in &values {
                     let t = [x, y, z];
                     let min = x.min(y).min(z);
-                    assert_eq!(t[nearest(t)], min, "{t:?}");
+                    let (axis, time) = nearest(t);
+                    assert_eq!(t[axis], min, "{t:?}");
+                    assert_eq!(time, min, "{t:?}");
                 }
             }
         }

@@ -285,8 +285,8 @@ impl Octree {
                 for a in 0..3 {
                     exit[a] = if octant >> a & 1 == 1 { t1[a] } else { mid[a] };
                 }
-                let a = nearest(exit);
-                if octant >> a & 1 == 1 || exit[a] > t_max {
+                let (a, t) = nearest(exit);
+                if octant >> a & 1 == 1 || t > t_max {
                     break;
                 }
                 octant |= 1 << a;
