@@ -16,6 +16,8 @@
 //! box out of the ray's way.
 
 use super::ray_f32::{round_down, round_up, BoxRay};
+#[cfg(target_arch = "x86_64")]
+use super::ray_f32::BoxRayAvx;
 use super::simd::F4;
 use crate::math::{Bounds3, Ray};
 use std::mem::MaybeUninit;
@@ -384,12 +386,12 @@ impl Bvh {
         if self.nodes.is_empty() {
             return;
         }
-        let r = BoxRay::new(ray);
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx") && std::is_x86_feature_detected!("fma") {
             // SAFETY: the CPU has AVX and FMA.
-            return unsafe { self.traverse_avx::<NEAREST_FIRST>(&r, t_max, items, visit) };
+            return unsafe { self.traverse_avx::<NEAREST_FIRST>(ray, t_max, items, visit) };
         }
+        let r = BoxRay::new(ray);
         self.traverse_with::<NEAREST_FIRST>(t_max, items, visit, |planes, far| {
             r.test8(planes, F4::splat(far))
         });
@@ -403,13 +405,13 @@ impl Bvh {
     #[target_feature(enable = "avx,fma")]
     unsafe fn traverse_avx<const NEAREST_FIRST: bool>(
         &self,
-        r: &BoxRay,
+        ray: &Ray,
         t_max: f64,
         items: LeafItems,
         visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
         // SAFETY: this function runs only where the CPU has AVX and FMA.
-        let wide = unsafe { r.avx() };
+        let wide = unsafe { BoxRayAvx::new(ray) };
         self.traverse_with::<NEAREST_FIRST>(t_max, items, visit, |planes, far| unsafe {
             wide.test8(planes, far)
         });

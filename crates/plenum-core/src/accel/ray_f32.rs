@@ -48,27 +48,34 @@ pub struct BoxRay {
 /// roundings of the reciprocal direction, with margin.
 const FAR_SCALE: f32 = 1.0 + 2.0 * gamma_f32(5);
 
+/// The ray's numbers for the box tests, in lanes x, y, z: the reciprocal direction and the f32
+/// origin rounded up and down. Per ray, so kept to one vector division and no branches.
+#[inline(always)]
+fn prepare(ray: &Ray) -> (F4, F4, F4) {
+    let (o, d) = (ray.origin, ray.direction);
+    // A zero component would make 0·∞ = NaN at a plane through the origin; a tiny one
+    // gives the same answer without it.
+    let away = |x: f64| x.abs().max(1e-30).copysign(x) as f32;
+    let inv = F4::splat(1.0).div(F4::from_array([away(d.x), away(d.y), away(d.z), 1.0]));
+    // The f32 origin moved by two ulps either way brackets the f64 one, and its product
+    // with 1/d, rounded, still brackets o·(1/d) (see `BoxRayAvx::new`).
+    let o = F4::from_array([o.x as f32, o.y as f32, o.z as f32, 0.0]);
+    let ulp = o
+        .abs()
+        .mul(F4::splat(2.0 * f32::EPSILON))
+        .add(F4::splat(f32::MIN_POSITIVE));
+    (inv, o.add(ulp), o.sub(ulp))
+}
+
 impl BoxRay {
-    /// Per ray, so kept to one vector division and no branches.
     #[inline]
     pub fn new(ray: &Ray) -> BoxRay {
-        let (o, d) = (ray.origin, ray.direction);
-        // A zero component would make 0·∞ = NaN at a plane through the origin; a tiny one
-        // gives the same answer without it.
-        let away = |x: f64| x.abs().max(1e-30).copysign(x) as f32;
-        let inv = F4::splat(1.0).div(F4::from_array([away(d.x), away(d.y), away(d.z), 1.0]));
-        // The f32 origin moved by two ulps either way brackets the f64 one, and its product
-        // with 1/d, rounded, still brackets o·(1/d) (see `avx`).
-        let o = F4::from_array([o.x as f32, o.y as f32, o.z as f32, 0.0]);
-        let ulp = o
-            .abs()
-            .mul(F4::splat(2.0 * f32::EPSILON))
-            .add(F4::splat(f32::MIN_POSITIVE));
+        let (inv, up, down) = prepare(ray);
         // Lanes spread in registers: a store and narrower reloads would stall forwarding.
         let xyz = F4::spread3;
         BoxRay {
-            origin_up: xyz(o.add(ulp)),
-            origin_down: xyz(o.sub(ulp)),
+            origin_up: xyz(up),
+            origin_down: xyz(down),
             inv_dir: xyz(inv),
         }
     }
@@ -112,42 +119,6 @@ impl BoxRay {
         out[4..].copy_from_slice(&n1.to_array());
         (out, m0 | (m1 << 4))
     }
-
-    /// The ray's numbers in 256-bit vectors, for [`BoxRayAvx::test8`].
-    ///
-    /// # Safety
-    /// The CPU must support AVX.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    #[inline]
-    pub unsafe fn avx(&self) -> BoxRayAvx {
-        use std::arch::x86_64::_mm256_set_m128;
-        let wide = |x: F4| _mm256_set_m128(x.raw(), x.raw());
-        let mut ray = BoxRayAvx {
-            inv_dir: self.inv_dir.map(wide),
-            entry_offset: [0; 3],
-            exit_offset: [0; 3],
-            entry_shift: self.inv_dir.map(wide),
-            exit_shift: self.inv_dir.map(wide),
-        };
-        for a in 0..3 {
-            let inv = self.inv_dir[a];
-            // o·(1/d) for each bracketing origin: the larger one never overestimates an entry
-            // distance, the smaller one never underestimates an exit, whatever the sign.
-            let (up, down) = (self.origin_up[a].mul(inv), self.origin_down[a].mul(inv));
-            ray.entry_shift[a] = wide(up.max(down));
-            ray.exit_shift[a] = wide(up.min(down));
-            // The ray enters a slab through its min plane when it runs up the axis.
-            let (entry, exit) = if inv.to_array()[0] >= 0.0 {
-                (a, 3 + a)
-            } else {
-                (3 + a, a)
-            };
-            ray.entry_offset[a] = entry * std::mem::size_of::<[f32; 8]>();
-            ray.exit_offset[a] = exit * std::mem::size_of::<[f32; 8]>();
-        }
-        ray
-    }
 }
 
 /// A [`BoxRay`] in AVX registers: eight boxes per test, each slab distance one fused
@@ -166,6 +137,41 @@ pub struct BoxRayAvx {
 
 #[cfg(target_arch = "x86_64")]
 impl BoxRayAvx {
+    /// Made straight from the ray, each number computed once in four lanes and then spread:
+    /// per ray, so it matters.
+    ///
+    /// # Safety
+    /// The CPU must support AVX.
+    #[target_feature(enable = "avx")]
+    #[inline]
+    pub unsafe fn new(ray: &Ray) -> BoxRayAvx {
+        use std::arch::x86_64::*;
+        let (inv, up, down) = prepare(ray);
+        // o·(1/d) for each bracketing origin: the larger one never overestimates an entry
+        // distance, the smaller one never underestimates an exit, whatever the sign.
+        let (up, down) = (up.mul(inv), down.mul(inv));
+        let spread = |v: F4| {
+            let v = v.raw();
+            let lanes = [
+                _mm_permute_ps::<0x00>(v),
+                _mm_permute_ps::<0x55>(v),
+                _mm_permute_ps::<0xAA>(v),
+            ];
+            lanes.map(|l| _mm256_set_m128(l, l))
+        };
+        // The ray enters a slab through its min plane when it runs up the axis.
+        let down_axis = inv.lt(F4::splat(0.0));
+        let row = std::mem::size_of::<[f32; 8]>();
+        let plane = |a: usize, max_side: bool| (a + 3 * max_side as usize) * row;
+        BoxRayAvx {
+            inv_dir: spread(inv),
+            entry_offset: [0, 1, 2].map(|a| plane(a, down_axis >> a & 1 == 1)),
+            exit_offset: [0, 1, 2].map(|a| plane(a, down_axis >> a & 1 == 0)),
+            entry_shift: spread(up.max(down)),
+            exit_shift: spread(up.min(down)),
+        }
+    }
+
     /// Entry distances of eight boxes and the mask of those the ray crosses in [0, far].
     /// Like [`BoxRay::test8`] but for rounding: one rounding per distance instead of two.
     ///
@@ -266,7 +272,7 @@ mod tests {
             #[cfg(target_arch = "x86_64")]
             if std::is_x86_feature_detected!("avx") && std::is_x86_feature_detected!("fma") {
                 // SAFETY: AVX and FMA were detected.
-                results.push(unsafe { r.avx().test8(&planes, far) });
+                results.push(unsafe { BoxRayAvx::new(&ray).test8(&planes, far) });
             }
             for (near, mask) in results {
                 for lane in 0..8 {
