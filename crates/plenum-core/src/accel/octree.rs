@@ -10,10 +10,10 @@ use super::{nearest, split_off_large};
 use crate::math::{Bounds3, Ray, Vec3};
 use std::mem::MaybeUninit;
 
-const LEAF_ITEMS: usize = 8;
+const LEAF_ITEMS: usize = 4;
 const MAX_DEPTH: usize = 16;
 /// Visiting a cell's children, in item tests.
-const SPLIT_COST: usize = 8;
+const SPLIT_COST: usize = 4;
 /// A ray passes through at most four of a cell's children.
 const STACK: usize = 3 * MAX_DEPTH + 2;
 
@@ -239,7 +239,7 @@ impl Octree {
         while top > 0 {
             top -= 1;
             // SAFETY: entries below `top` were written when pushed.
-            let (index, t0, t1) = unsafe { stack[top].assume_init() };
+            let (index, t0, t1) = unsafe { stack.get_unchecked(top).assume_init() };
             // Plain comparisons: the distances are never NaN, so f64::max's NaN rules would
             // only cost instructions.
             let larger = |a: f64, b: f64| if a > b { a } else { b };
@@ -269,12 +269,15 @@ impl Octree {
             for a in 0..3 {
                 mid[a] = 0.5 * (t0[a] + t1[a]);
             }
-            // The child the ray enters first: upper along each axis whose mid-plane it
-            // crossed before entering. Then, until it leaves the cell, the next child is
-            // across the nearest of the current child's exit planes.
+            // The first child the ray is in ahead of its origin: upper along each axis whose
+            // mid-plane it crossed before entering the cell, or before starting where it
+            // starts inside (children behind the origin are never pushed). Then, until it
+            // leaves the cell, the next child is across the nearest of the current child's
+            // exit planes.
+            let start = larger(enter, 0.0);
             let mut octant = 0;
             for a in 0..3 {
-                octant |= usize::from(mid[a] < enter) << a;
+                octant |= usize::from(mid[a] < start) << a;
             }
             let mut path = [0usize; 4];
             let mut n = 0;
@@ -305,7 +308,11 @@ impl Octree {
                         c1[a] = mid[a];
                     }
                 }
-                stack[top].write((child, c0, c1));
+                // A cell pops one entry and pushes at most four, and cells nest at most
+                // MAX_DEPTH deep, so `top` stays below 3 · MAX_DEPTH + 2.
+                debug_assert!(top < STACK);
+                // SAFETY: see above.
+                unsafe { stack.get_unchecked_mut(top).write((child, c0, c1)) };
                 top += 1;
             }
         }
