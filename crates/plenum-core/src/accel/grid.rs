@@ -232,9 +232,19 @@ impl Grid {
                 let mut c = self.index(cell);
                 // Walk the cells until the ray leaves the macro cell along axis `a`.
                 let a = loop {
-                    let (first, end) = (self.starts[c] as usize, self.starts[c + 1] as usize);
+                    debug_assert!(c + 1 < self.starts.len());
+                    // SAFETY: `c` indexes the cell `cell`, inside the grid (checked after
+                    // each step), and `starts` has one more entry than there are cells.
+                    let (first, end) = unsafe {
+                        (
+                            *self.starts.get_unchecked(c) as usize,
+                            *self.starts.get_unchecked(c + 1) as usize,
+                        )
+                    };
                     if first < end {
-                        let items = &self.items[first..end];
+                        debug_assert!(end <= self.items.len());
+                        // SAFETY: `starts` holds ascending offsets into `items`.
+                        let items = unsafe { self.items.get_unchecked(first..end) };
                         let go_on = if UNIQUE {
                             mailbox
                                 .get_or_insert_with(|| Mailbox::start(self.owner, self.item_count))
