@@ -53,10 +53,11 @@ const FAR_SCALE: f32 = 1.0 + 2.0 * gamma_f32(5);
 #[inline(always)]
 fn prepare(ray: &Ray) -> (F4, F4, F4) {
     let (o, d) = (ray.origin, ray.direction);
+    let d = F4::from_array([d.x as f32, d.y as f32, d.z as f32, 1.0]);
     // A zero component would make 0·∞ = NaN at a plane through the origin; a tiny one
     // gives the same answer without it.
-    let away = |x: f64| x.abs().max(1e-30).copysign(x) as f32;
-    let inv = F4::splat(1.0).div(F4::from_array([away(d.x), away(d.y), away(d.z), 1.0]));
+    let away = d.abs().max(F4::splat(1e-30)).copysign(d);
+    let inv = F4::splat(1.0).div(away);
     // The f32 origin moved by two ulps either way brackets the f64 one, and its product
     // with 1/d, rounded, still brackets o·(1/d) (see `BoxRayAvx::new`).
     let o = F4::from_array([o.x as f32, o.y as f32, o.z as f32, 0.0]);
@@ -121,6 +122,28 @@ impl BoxRay {
     }
 }
 
+/// For each set of axes the ray runs down (bit a for axis a), the byte offsets within a
+/// node's planes of the plane it enters each slab through and of the one it leaves through:
+/// the min plane (row a) and then the max plane (row 3 + a) when it runs up the axis, the
+/// other way round when it runs down.
+#[cfg(target_arch = "x86_64")]
+const PLANE_OFFSETS: [[[usize; 3]; 2]; 8] = {
+    let row = std::mem::size_of::<[f32; 8]>();
+    let mut table = [[[0; 3]; 2]; 8];
+    let mut signs = 0;
+    while signs < 8 {
+        let mut a = 0;
+        while a < 3 {
+            let down = (signs >> a) & 1;
+            table[signs][0][a] = (a + 3 * down) * row;
+            table[signs][1][a] = (a + 3 * (1 - down)) * row;
+            a += 1;
+        }
+        signs += 1;
+    }
+    table
+};
+
 /// A [`BoxRay`] in AVX registers: eight boxes per test, each slab distance one fused
 /// multiply-subtract from the plane the ray enters or leaves through.
 #[cfg(target_arch = "x86_64")]
@@ -159,14 +182,12 @@ impl BoxRayAvx {
             ];
             lanes.map(|l| _mm256_set_m128(l, l))
         };
-        // The ray enters a slab through its min plane when it runs up the axis.
-        let down_axis = inv.lt(F4::splat(0.0));
-        let row = std::mem::size_of::<[f32; 8]>();
-        let plane = |a: usize, max_side: bool| (a + 3 * max_side as usize) * row;
+        // Looked up by the signs, where working them out takes six selects.
+        let [entry_offset, exit_offset] = PLANE_OFFSETS[inv.lt(F4::splat(0.0)) as usize & 7];
         BoxRayAvx {
             inv_dir: spread(inv),
-            entry_offset: [0, 1, 2].map(|a| plane(a, down_axis >> a & 1 == 1)),
-            exit_offset: [0, 1, 2].map(|a| plane(a, down_axis >> a & 1 == 0)),
+            entry_offset,
+            exit_offset,
             entry_shift: spread(up.max(down)),
             exit_shift: spread(up.min(down)),
         }
