@@ -10,10 +10,10 @@ use super::{nearest, split_off_large};
 use crate::math::{Bounds3, Ray, Vec3};
 use std::mem::MaybeUninit;
 
-const LEAF_ITEMS: usize = 4;
+const LEAF_ITEMS: usize = 8;
 const MAX_DEPTH: usize = 16;
 /// Visiting a cell's children, in item tests.
-const SPLIT_COST: usize = 4;
+const SPLIT_COST: usize = 8;
 /// A ray passes through at most four of a cell's children.
 const STACK: usize = 3 * MAX_DEPTH + 2;
 
