@@ -15,9 +15,9 @@
 //! and the ray origin is rounded up or down per plane so that the f32 origin never moves a
 //! box out of the ray's way.
 
-use super::ray_f32::{round_down, round_up, BoxRay};
 #[cfg(target_arch = "x86_64")]
 use super::ray_f32::BoxRayAvx;
+use super::ray_f32::{round_down, round_up, BoxRay};
 use super::simd::F4;
 use crate::math::{Bounds3, Ray};
 use std::mem::MaybeUninit;

@@ -82,7 +82,10 @@ mod imp {
         pub fn copysign(self, o: F4) -> F4 {
             unsafe {
                 let sign = _mm_set1_ps(-0.0);
-                F4(_mm_or_ps(_mm_andnot_ps(sign, self.0), _mm_and_ps(sign, o.0)))
+                F4(_mm_or_ps(
+                    _mm_andnot_ps(sign, self.0),
+                    _mm_and_ps(sign, o.0),
+                ))
             }
         }
         /// Bit i set where lane i of `self` ≤ lane i of `o`.
@@ -227,8 +230,13 @@ mod tests {
         let b = F4::splat(2.0);
         assert_eq!(a.add(b).to_array()[..3], [3.0, 0.0, 5.0]);
         assert_eq!(a.abs().to_array()[1], 2.0);
-        let signed = b.copysign(F4::from_array([-1.0, 1.0, -0.0, 0.0])).to_array();
-        assert_eq!(signed.map(f32::to_bits), [-2.0f32, 2.0, -2.0, 2.0].map(f32::to_bits));
+        let signed = b
+            .copysign(F4::from_array([-1.0, 1.0, -0.0, 0.0]))
+            .to_array();
+        assert_eq!(
+            signed.map(f32::to_bits),
+            [-2.0f32, 2.0, -2.0, 2.0].map(f32::to_bits)
+        );
         assert_eq!(a.le(b), 0b0011);
         assert_eq!(a.lt(F4::splat(1.0)), 0b0010);
         // NaN lanes take the second operand, which the slab test relies on.
