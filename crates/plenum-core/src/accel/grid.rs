@@ -144,10 +144,8 @@ impl Grid {
     }
 
     /// The cell of a point along one axis, clamped to the grid.
+    /// Along a flat axis the inverse cell size is 0, which puts every point in its one cell.
     fn cell_of(&self, x: f64, axis: usize) -> usize {
-        if self.cell_size[axis] <= 0.0 {
-            return 0;
-        }
         // Truncation is floor here (c ≥ 0), without a call into libm; a signed conversion
         // is one instruction, and the clamp keeps it in range.
         let c = (x - self.bounds.min[axis]) * self.inv_cell_size[axis];
