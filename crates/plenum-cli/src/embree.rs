@@ -111,7 +111,8 @@ impl EmbreeMesh {
             let scene = rtcNewScene(device);
             rtcSetSceneBuildQuality(scene, BUILD_QUALITY_HIGH);
             let geometry = rtcNewGeometry(device, GEOMETRY_TYPE_TRIANGLE);
-            let positions: Vec<_> = mesh.positions().collect();
+            // In the order the mesh was made from: hits then name triangles as its file does.
+            let (positions, triangles) = mesh.indexed();
             let vertices = rtcSetNewGeometryBuffer(
                 geometry,
                 BUFFER_TYPE_VERTEX,
@@ -120,7 +121,6 @@ impl EmbreeMesh {
                 12,
                 positions.len(),
             ) as *mut f32;
-            let triangles = mesh.triangles();
             let indices = rtcSetNewGeometryBuffer(
                 geometry,
                 BUFFER_TYPE_INDEX,
@@ -141,9 +141,8 @@ impl EmbreeMesh {
                 }
             }
             for (i, t) in triangles.iter().enumerate() {
-                let at = mesh.source_triangle(i as u32) as usize;
                 for (a, &v) in t.iter().enumerate() {
-                    *indices.add(3 * at + a) = v;
+                    *indices.add(3 * i + a) = v;
                 }
             }
             rtcCommitGeometry(geometry);

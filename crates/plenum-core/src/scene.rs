@@ -313,8 +313,11 @@ impl Scene {
     /// barycentric coordinates.
     pub fn coefficients(&self, it: &Interaction) -> Coefficients {
         let p = &self.primitives[it.primitive as usize];
-        if let (Some(ids), Shape::Mesh(mesh)) = (&p.vertex_materials, &p.shape) {
-            let triangle = mesh.triangles()[it.hit.part as usize];
+        let corners = match (&p.vertex_materials, &p.shape) {
+            (Some(ids), Shape::Mesh(mesh)) => mesh.vertex_indices(it.hit.part).map(|t| (ids, t)),
+            _ => None,
+        };
+        if let Some((ids, triangle)) = corners {
             let (b1, b2) = (it.hit.u, it.hit.v);
             let weights = [1.0 - b1 - b2, b1, b2];
             let parts = [0, 1, 2].map(|i| {
@@ -372,7 +375,9 @@ impl SceneBuilder {
         self.object_names.push(name.into());
     }
 
-    /// Places a mesh whose material varies per vertex (one id per mesh vertex).
+    /// Places a mesh whose material varies per vertex (one id per mesh vertex). The mesh must
+    /// keep its vertex indices ([`crate::geometry::TriangleMesh::new_keeping_indices`]); where
+    /// it does not, the first material is shown.
     pub fn add_mesh_with_vertex_materials(
         &mut self,
         name: impl Into<String>,
@@ -467,8 +472,7 @@ impl SceneBuilder {
         let name = name.into();
         let triangles = mesh
             .triangles()
-            .iter()
-            .map(|t| t.map(|i| to_world.point(mesh.position(i))))
+            .map(|(_, t)| t.map(|p| to_world.point(p)))
             .collect();
         let material = self.add_material(format!("{name} (emitter)"), Material::emitter(radiance));
         self.add_object(name.clone(), Shape::Mesh(mesh), to_world, material);

@@ -942,7 +942,8 @@ impl<'s> Reader<'s> {
             .collect()
     }
 
-    /// A mesh from `file` (OBJ or PLY) or from inline `positions` and `indices`.
+    /// A mesh from `file` (OBJ or PLY) or from inline `positions` and `indices`, keeping its
+    /// vertex indices: an object may give it `vertex_materials`.
     fn mesh_data(&mut self, f: &Fields<'_, 's>) -> Result<Arc<TriangleMesh>> {
         let src = self.src;
         f.one_of(&["mesh", "file", "positions"])?;
@@ -963,13 +964,13 @@ impl<'s> Reader<'s> {
             return match extension.as_str() {
                 "obj" => {
                     let text = std::fs::read_to_string(&path).map_err(unreadable)?;
-                    let mut model = obj::parse_obj_model(&path, &text, false)?;
+                    let mut model = obj::parse_obj_model_with(&path, &text, false, true)?;
                     self.warnings.append(&mut model.warnings);
                     Ok(Arc::new(model.groups.remove(0).1))
                 }
                 "ply" => {
                     std::fs::metadata(&path).map_err(unreadable)?;
-                    ply::load_ply(&path).map(Arc::new)
+                    ply::load_ply_with(&path, true).map(Arc::new)
                 }
                 _ => Err(src.error(file.span(), "expected a mesh file: .obj or .ply")),
             };
@@ -1014,7 +1015,7 @@ impl<'s> Reader<'s> {
                 .collect::<Result<Vec<_>>>()?,
             None => Vec::new(),
         };
-        TriangleMesh::new(positions, triangles, normals, uvs)
+        TriangleMesh::new_keeping_indices(positions, triangles, normals, uvs)
             .map(Arc::new)
             .map_err(|e| src.error(pv.span(), e.to_string()))
     }

@@ -26,6 +26,17 @@ pub fn parse_obj(path: &Path, text: &str) -> Result<TriangleMesh, SceneError> {
 
 /// Parses OBJ text; with `by_material`, one mesh per `usemtl` material.
 pub fn parse_obj_model(path: &Path, text: &str, by_material: bool) -> Result<ObjModel, SceneError> {
+    parse_obj_model_with(path, text, by_material, false)
+}
+
+/// [`parse_obj_model`], the meshes keeping their vertex indices if `keep_indices`, for data
+/// given per vertex elsewhere (see `TriangleMesh::new_keeping_indices`).
+pub(crate) fn parse_obj_model_with(
+    path: &Path,
+    text: &str,
+    by_material: bool,
+    keep_indices: bool,
+) -> Result<ObjModel, SceneError> {
     let mut material_libraries = Vec::new();
     let mut material_names: Vec<Option<String>> = vec![None];
     let mut current_material = 0usize;
@@ -170,12 +181,13 @@ pub fn parse_obj_model(path: &Path, text: &str, by_material: bool) -> Result<Obj
         out_uvs.clear();
     }
     let build = |tris: Vec<[u32; 3]>| {
-        TriangleMesh::new(
-            out_positions.clone(),
-            tris,
-            out_normals.clone(),
-            out_uvs.clone(),
-        )
+        let (positions, normals, uvs) =
+            (out_positions.clone(), out_normals.clone(), out_uvs.clone());
+        if keep_indices {
+            TriangleMesh::new_keeping_indices(positions, tris, normals, uvs)
+        } else {
+            TriangleMesh::new(positions, tris, normals, uvs)
+        }
         .map_err(|e| SceneError::file(path, e.to_string()))
     };
     let groups = if by_material {

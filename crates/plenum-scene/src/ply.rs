@@ -71,13 +71,28 @@ enum Format {
 
 /// Reads a PLY file into a triangle mesh.
 pub fn load_ply(path: &Path) -> Result<TriangleMesh, SceneError> {
+    load_ply_with(path, false)
+}
+
+/// [`load_ply`], the mesh keeping its vertex indices if `keep_indices`, for data given per
+/// vertex elsewhere (see `TriangleMesh::new_keeping_indices`).
+pub(crate) fn load_ply_with(path: &Path, keep_indices: bool) -> Result<TriangleMesh, SceneError> {
     let bytes = std::fs::read(path)
         .map_err(|e| SceneError::file(path, format!("cannot read the mesh file: {e}")))?;
-    parse_ply(path, &bytes)
+    parse_ply_with(path, &bytes, keep_indices)
 }
 
 /// Parses PLY bytes; errors are located in `path`.
+#[cfg(test)]
 pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<TriangleMesh, SceneError> {
+    parse_ply_with(path, bytes, false)
+}
+
+fn parse_ply_with(
+    path: &Path,
+    bytes: &[u8],
+    keep_indices: bool,
+) -> Result<TriangleMesh, SceneError> {
     let end = find(bytes, b"end_header")
         .ok_or_else(|| SceneError::file(path, "not a PLY file: no `end_header` line"))?;
     let body_start = bytes[end..]
@@ -263,8 +278,12 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<TriangleMesh, SceneError> 
     if uvs.len() != positions.len() {
         uvs.clear();
     }
-    TriangleMesh::new(positions, triangles, normals, uvs)
-        .map_err(|e| SceneError::file(path, e.to_string()))
+    if keep_indices {
+        TriangleMesh::new_keeping_indices(positions, triangles, normals, uvs)
+    } else {
+        TriangleMesh::new(positions, triangles, normals, uvs)
+    }
+    .map_err(|e| SceneError::file(path, e.to_string()))
 }
 
 fn find(haystack: &[u8], needle: &[u8]) -> Option<usize> {
@@ -440,7 +459,7 @@ mod tests {
             assert_eq!(mesh.triangle_count(), 2);
             // The mesh numbers its vertices in its own order.
             for (x, y) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
-                assert!(mesh.positions().any(|p| p == Vec3::new(x, y, 0.0)));
+                assert!(mesh.indexed().0.contains(&Vec3::new(x, y, 0.0)));
             }
             let cut = &bytes[..bytes.len() - 3];
             assert!(parse_ply(Path::new("q.ply"), cut)

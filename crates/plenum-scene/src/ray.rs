@@ -993,7 +993,7 @@ impl<'s> Parser<'s> {
             };
             vertex_materials.push(id);
         }
-        let mesh = TriangleMesh::new(points, triangles, normals, Vec::new())
+        let mesh = TriangleMesh::new_keeping_indices(points, triangles, normals, Vec::new())
             .map_err(|e| self.error(span.clone(), e.to_string()))?;
         self.builder.add_mesh_with_vertex_materials(
             name,

@@ -339,10 +339,11 @@ fn texture(t: &Texture) -> String {
 }
 
 fn mesh_arrays(m: &plenum_core::geometry::TriangleMesh) -> String {
+    let (positions, triangles) = m.indexed();
     let mut s = format!(
         "positions = {}\nindices = [{}]",
-        points(&m.positions().collect::<Vec<_>>()),
-        m.triangles()
+        points(&positions),
+        triangles
             .iter()
             .map(|t| format!("[{}, {}, {}]", t[0], t[1], t[2]))
             .collect::<Vec<_>>()

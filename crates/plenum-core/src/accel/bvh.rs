@@ -211,6 +211,9 @@ impl BuildNode {
 }
 
 impl Bvh {
+    /// What pads a leaf's run to whole blocks in [`Bvh::take_padded_order`].
+    pub const PAD: u32 = u32::MAX;
+
     /// Builds over items given by their bounds, with at most `max_leaf` items per leaf, for a
     /// caller that tests `block` items at a time; the leaves refer to items by position.
     /// Empty boxes are left out.
@@ -301,8 +304,9 @@ impl Bvh {
     }
 
     /// Asks for a child the traversal will visit later, so it arrives while others are
-    /// tested: a node's four cache lines, or the first two of a leaf's items. Without
-    /// branches or a loop: whether a child is a leaf is a coin toss to the branch predictor.
+    /// tested: a node's four cache lines, or the first four lines of a leaf's items (a block
+    /// of four triangles, wherever it starts in its first line). Without branches: whether a
+    /// child is a leaf is a coin toss to the branch predictor.
     #[inline(always)]
     fn prefetch(&self, child: u32, items: LeafItems) {
         #[cfg(target_arch = "x86_64")]
@@ -314,16 +318,13 @@ impl Bvh {
                 .wrapping_add((child & START_MASK) as usize * items.stride)
                 as *const i8;
             let p = std::hint::select_unpredictable(is_node, node, leaf);
-            // A leaf asks for its two lines twice over instead of a node's last two.
-            let rest = p.wrapping_add(if is_node { 128 } else { 0 });
             // SAFETY: prefetching is only a hint; it never faults, so the address needs no
             // bounds check.
             unsafe {
                 use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-                _mm_prefetch(p, _MM_HINT_T0);
-                _mm_prefetch(p.wrapping_add(64), _MM_HINT_T0);
-                _mm_prefetch(rest, _MM_HINT_T0);
-                _mm_prefetch(rest.wrapping_add(64), _MM_HINT_T0);
+                for line in 0..4 {
+                    _mm_prefetch(p.wrapping_add(64 * line), _MM_HINT_T0);
+                }
             }
         }
         #[cfg(not(target_arch = "x86_64"))]
@@ -335,44 +336,72 @@ impl Bvh {
     /// and returns false to stop.
     #[inline]
     pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
-        self.traverse_runs(ray, t_max, &self.order, |run, t_max| {
+        self.traverse_runs(ray, t_max, LeafItems::of(&self.order), |run, t_max| {
             visit(&self.order[run], t_max)
         });
     }
 
-    /// Hands the caller the items in leaf order and leaves the BVH without them: for a caller
-    /// that stores its items in this order, so that leaves name runs of them directly
-    /// ([`Bvh::traverse_runs`]) and no index is read per item. [`Bvh::traverse`] must not be
-    /// used afterwards.
-    pub fn take_order(&mut self) -> Vec<u32> {
-        std::mem::take(&mut self.order)
+    /// Hands the caller the items in leaf order, each leaf padded with [`Bvh::PAD`] entries to a
+    /// whole number of `block`s, and leaves the BVH without them: for a caller that stores
+    /// its items in this order, so that leaves name runs of them directly
+    /// ([`Bvh::traverse_runs`]), no index is read per item, and every leaf starts a block.
+    /// Items the BVH left out (empty boxes) are not in it. [`Bvh::traverse`] must not be used
+    /// afterwards.
+    pub fn take_padded_order(&mut self, block: usize) -> Vec<u32> {
+        let order = std::mem::take(&mut self.order);
+        let mut leaves: Vec<(u32, usize, usize)> = Vec::new(); // (reference, node, slot)
+        for (n, node) in self.nodes.iter().enumerate() {
+            for (slot, &child) in node.children.iter().enumerate() {
+                if node.used & (1 << slot) != 0 && child & LEAF_BIT != 0 {
+                    leaves.push((child, n, slot));
+                }
+            }
+        }
+        leaves.sort_unstable_by_key(|&(child, _, _)| child & START_MASK);
+        let mut padded = Vec::with_capacity(order.len() + leaves.len() * (block - 1));
+        for (child, n, slot) in leaves {
+            let start = (child & START_MASK) as usize;
+            let count = ((child & !LEAF_BIT) >> COUNT_SHIFT) as usize;
+            let new_start = padded.len() as u32;
+            assert!(
+                new_start <= START_MASK,
+                "too many items for a BVH leaf reference"
+            );
+            padded.extend_from_slice(&order[start..start + count]);
+            padded.resize(
+                new_start as usize + count.div_ceil(block) * block,
+                Self::PAD,
+            );
+            self.nodes[n].children[slot] = LEAF_BIT | ((count as u32) << COUNT_SHIFT) | new_start;
+        }
+        padded
     }
 
     /// [`Bvh::traverse`] handing each leaf as its run of positions in the leaf order.
-    /// `items` is what the runs index (the caller's items in leaf order), so that a leaf's
-    /// items can be fetched ahead of their test.
+    /// `items` says where the runs' items lie, so that a leaf's items can be fetched ahead
+    /// of their test.
     #[inline]
-    pub fn traverse_runs<T>(
+    pub fn traverse_runs(
         &self,
         ray: &Ray,
         t_max: f64,
-        items: &[T],
+        items: LeafItems,
         visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
-        self.traverse_dispatch::<true>(ray, t_max, LeafItems::of(items), visit);
+        self.traverse_dispatch::<true>(ray, t_max, items, visit);
     }
 
     /// [`Bvh::traverse_runs`] for a caller that stops at any hit, such as a shadow ray: the
     /// leaves come in no particular order, which spares sorting the children of each node.
     #[inline]
-    pub fn traverse_runs_any_order<T>(
+    pub fn traverse_runs_any_order(
         &self,
         ray: &Ray,
         t_max: f64,
-        items: &[T],
+        items: LeafItems,
         visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
-        self.traverse_dispatch::<false>(ray, t_max, LeafItems::of(items), visit);
+        self.traverse_dispatch::<false>(ray, t_max, items, visit);
     }
 
     #[inline(always)]
@@ -526,16 +555,22 @@ impl Bvh {
 
 /// Where the items a leaf's run indexes lie, for prefetching.
 #[derive(Clone, Copy)]
-struct LeafItems {
+pub struct LeafItems {
     base: *const u8,
     stride: usize,
 }
 
 impl LeafItems {
-    fn of<T>(items: &[T]) -> LeafItems {
+    /// One item per element of `items`.
+    pub fn of<T>(items: &[T]) -> LeafItems {
+        LeafItems::packed(items, 1)
+    }
+
+    /// `per_block` items per element of `blocks`, such as four triangles to a SIMD block.
+    pub fn packed<T>(blocks: &[T], per_block: usize) -> LeafItems {
         LeafItems {
-            base: items.as_ptr() as *const u8,
-            stride: std::mem::size_of::<T>(),
+            base: blocks.as_ptr() as *const u8,
+            stride: std::mem::size_of::<T>() / per_block,
         }
     }
 }
@@ -733,6 +768,50 @@ mod tests {
                 s
             }
         }
+    }
+
+    #[test]
+    fn padded_order_starts_every_leaf_on_a_block() {
+        use crate::math::Vec3;
+        // Boxes along a noisy curve, so leaves of every size occur.
+        let boxes: Vec<Bounds3> = (0..1000)
+            .map(|i| {
+                let x = i as f64 * 0.01;
+                let c = Vec3::new(x, (7.0 * x).sin(), ((i * 37) % 11) as f64 * 0.05);
+                Bounds3::new(c, c + Vec3::ONE * 0.02)
+            })
+            .collect();
+        let mut bvh = Bvh::build(&boxes, 8, 4);
+        let order = bvh.take_padded_order(4);
+        assert_eq!(order.len() % 4, 0);
+        let mut seen = vec![0; boxes.len()];
+        let mut covered = vec![false; order.len()];
+        for node in &bvh.nodes {
+            for (slot, &child) in node.children.iter().enumerate() {
+                if node.used & (1 << slot) == 0 || child & LEAF_BIT == 0 {
+                    continue;
+                }
+                let start = (child & START_MASK) as usize;
+                let count = ((child & !LEAF_BIT) >> COUNT_SHIFT) as usize;
+                assert_eq!(start % 4, 0, "a leaf starts inside a block");
+                for (k, &item) in order[start..start + count.next_multiple_of(4)]
+                    .iter()
+                    .enumerate()
+                {
+                    covered[start + k] = true;
+                    if k < count {
+                        seen[item as usize] += 1;
+                    } else {
+                        assert_eq!(item, Bvh::PAD);
+                    }
+                }
+            }
+        }
+        assert!(
+            seen.iter().all(|&n| n == 1),
+            "every item in exactly one leaf"
+        );
+        assert!(covered.iter().all(|&c| c), "no slot outside a leaf");
     }
 
     #[test]

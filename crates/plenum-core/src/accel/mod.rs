@@ -17,7 +17,7 @@ pub(crate) mod ray_f32;
 pub(crate) mod simd;
 
 pub use brute::BruteForce;
-pub use bvh::Bvh;
+pub use bvh::{Bvh, LeafItems};
 pub use grid::Grid;
 pub use octree::Octree;
 

@@ -1,14 +1,19 @@
 //! Triangle meshes with their own acceleration structure, intersected by the watertight
 //! ray–triangle test of Woop, Benthin and Wald (JCGT 2013): no ray slips through a shared
-//! edge or vertex. Vertices are stored in f32, like Embree and pbrt, and four triangles are
+//! edge or vertex. Corners are stored in f32, like Embree and pbrt, and four triangles are
 //! tested at once in f32 SIMD; the rare hit exactly on an edge is settled in f64. Error
-//! bounds follow pbrt-v4 §6.8.4. With a BVH the triangles are kept in its leaf order, so a
-//! leaf's triangles lie side by side in memory.
+//! bounds follow pbrt-v4 §6.8.4.
+//!
+//! The corners are stored four triangles to a block, in the lanes the SIMD test loads, as
+//! Embree's precomputed leaves are: with a BVH the blocks are in its leaf order and each leaf
+//! is a run of whole blocks, read without an index. Vertex indices are kept only where
+//! something is given per vertex (normals, uvs, or data the caller keeps, such as a scene's
+//! per-vertex materials).
 
 use super::{HitRecord, SurfaceGeometry};
 use crate::accel::ray_f32::{gamma_f32, round_up};
 use crate::accel::simd::F4;
-use crate::accel::{Accel, AccelKind, LeafSize};
+use crate::accel::{Accel, AccelKind, Bvh, LeafItems, LeafSize};
 use crate::math::{gamma, Bounds3, Ray, Vec3};
 use std::ops::Range;
 
@@ -18,19 +23,42 @@ const LEAF: LeafSize = LeafSize {
     block: 4,
 };
 
+/// Triangles per block.
+const LANES: usize = 4;
+
+/// A slot that only pads a BVH leaf to whole blocks.
+const PAD: u32 = Bvh::PAD;
+
+/// Four triangles' corners in f32, `[corner][axis][lane]`: the lanes the SIMD test loads.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+struct Block([[[f32; LANES]; 3]; 3]);
+
+/// A triangle's corners in f32, `[corner][axis]`.
+type Corners = [[f32; 3]; 3];
+
 #[derive(Clone, Debug)]
 pub struct TriangleMesh {
-    /// Positions in f32, the geometry the SIMD test sees, padded to four lanes; they are
-    /// the mesh's only copy (shading widens them to f64, exactly).
-    packed: Vec<[f32; 4]>,
+    /// With a BVH, the triangles' corners, slot `s` in lane `s % 4` of block `s / 4`; else
+    /// empty. With `vertices`, the mesh's only copy of its positions (shading widens them
+    /// to f64, exactly).
+    blocks: Vec<Block>,
+    /// With another structure, the vertex positions padded to four lanes; else empty. A
+    /// cell lists triangles from anywhere in the mesh: vertices shared by its triangles
+    /// are fetched once, where blocks would hold each triangle whole.
+    vertices: Vec<[f32; LANES]>,
+    /// Per slot, the triangle's position in the list the mesh was made from, or [`PAD`].
+    source: Vec<u32>,
+    /// Per slot, the triangle's vertex indices: with `vertices`, or where `keeps_indices`.
+    indices: Vec<[u32; 3]>,
+    /// The vertex indices the mesh was made with are kept (for normals, uvs, or the caller).
+    keeps_indices: bool,
     /// Per-vertex shading normals, or empty for flat shading.
     normals: Vec<Vec3>,
     /// Per-vertex texture coordinates, or empty.
     uvs: Vec<[f64; 2]>,
-    /// Stored in the BVH's leaf order, so a leaf is a run of consecutive triangles.
-    triangles: Vec<[u32; 3]>,
-    /// The position of each stored triangle in the list the mesh was made from.
-    source: Vec<u32>,
+    vertex_count: usize,
+    triangle_count: usize,
     accel: Accel,
     bounds: Bounds3,
     /// Every edge joins exactly two triangles: the mesh bounds a solid.
@@ -77,11 +105,34 @@ impl std::fmt::Display for MeshError {
 }
 
 impl TriangleMesh {
+    /// A mesh of `triangles` over `positions`, with per-vertex `normals` and `uvs` or none.
     pub fn new(
         positions: Vec<Vec3>,
         triangles: Vec<[u32; 3]>,
         normals: Vec<Vec3>,
         uvs: Vec<[f64; 2]>,
+    ) -> Result<TriangleMesh, MeshError> {
+        let keep_indices = !normals.is_empty() || !uvs.is_empty();
+        TriangleMesh::make(positions, triangles, normals, uvs, keep_indices)
+    }
+
+    /// [`TriangleMesh::new`] keeping the vertex indices whatever else is given, for data per
+    /// vertex that the caller keeps ([`TriangleMesh::vertex_indices`]).
+    pub fn new_keeping_indices(
+        positions: Vec<Vec3>,
+        triangles: Vec<[u32; 3]>,
+        normals: Vec<Vec3>,
+        uvs: Vec<[f64; 2]>,
+    ) -> Result<TriangleMesh, MeshError> {
+        TriangleMesh::make(positions, triangles, normals, uvs, true)
+    }
+
+    fn make(
+        positions: Vec<Vec3>,
+        triangles: Vec<[u32; 3]>,
+        normals: Vec<Vec3>,
+        uvs: Vec<[f64; 2]>,
+        keep_indices: bool,
     ) -> Result<TriangleMesh, MeshError> {
         if triangles.is_empty() {
             return Err(MeshError::NoTriangles);
@@ -108,111 +159,170 @@ impl TriangleMesh {
             }
         }
         // Each coordinate rounded to f32, as it is stored.
-        let positions: Vec<Vec3> = positions
+        let positions: Vec<[f32; 3]> = positions
             .iter()
-            .map(|p| Vec3::new(p.x as f32 as f64, p.y as f32 as f64, p.z as f32 as f64))
+            .map(|p| [p.x as f32, p.y as f32, p.z as f32])
             .collect();
-        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+        if let Some(i) = positions
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
             return Err(MeshError::NonFinitePosition(i));
         }
-        let packed = positions
-            .iter()
-            .map(|p| [p.x as f32, p.y as f32, p.z as f32, 0.0])
-            .collect();
+        let widened = |p: &[f32; 3]| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
         let closed = is_closed(&positions, &triangles);
+        let corners: Vec<Corners> = triangles
+            .iter()
+            .map(|t| t.map(|i| positions[i as usize]))
+            .collect();
         let mut mesh = TriangleMesh {
-            bounds: Bounds3::from_points(positions.iter().copied()),
-            packed,
+            blocks: Vec::new(),
+            vertices: Vec::new(),
+            source: Vec::new(),
+            indices: Vec::new(),
+            keeps_indices: keep_indices,
             normals,
             uvs,
-            source: (0..triangles.len() as u32).collect(),
-            triangles,
+            vertex_count: positions.len(),
+            triangle_count: triangles.len(),
             accel: Accel::default(),
+            bounds: Bounds3::from_points(positions.iter().map(widened)),
             closed,
         };
-        mesh.set_accel(AccelKind::Bvh);
+        let indices = if keep_indices { triangles } else { Vec::new() };
+        mesh.store(&corners, &indices, AccelKind::Bvh);
         Ok(mesh)
     }
 
     /// The mesh with its triangles in a `kind` structure instead.
     pub fn with_accel(&self, kind: AccelKind) -> TriangleMesh {
-        let mut mesh = self.clone_without_accel();
-        mesh.set_accel(kind);
+        let (corners, indices) = self.in_source_order();
+        let mut mesh = TriangleMesh {
+            blocks: Vec::new(),
+            vertices: Vec::new(),
+            source: Vec::new(),
+            indices: Vec::new(),
+            normals: self.normals.clone(),
+            uvs: self.uvs.clone(),
+            accel: Accel::default(),
+            ..*self
+        };
+        mesh.store(&corners, &indices, kind);
         mesh
     }
 
     /// Rebuilds the triangles' structure as a `kind` one. A BVH reorders the triangles to
     /// its leaf order (see [`TriangleMesh::source_triangle`]).
     pub fn set_accel(&mut self, kind: AccelKind) {
-        self.accel = Accel::build(kind, &self.triangle_bounds(), LEAF);
-        if let Accel::Bvh(bvh) = &mut self.accel {
-            let mut order = bvh.take_order();
-            // Every triangle has a box, so every one is in the order; but keep any left out.
-            if order.len() < self.triangles.len() {
-                let mut listed = vec![false; self.triangles.len()];
-                order.iter().for_each(|&i| listed[i as usize] = true);
-                order.extend((0..self.triangles.len() as u32).filter(|&i| !listed[i as usize]));
-            }
-            self.triangles = order.iter().map(|&i| self.triangles[i as usize]).collect();
-            self.source = order.iter().map(|&i| self.source[i as usize]).collect();
-            self.number_vertices_by_first_use();
-        }
+        let (corners, indices) = self.in_source_order();
+        self.store(&corners, &indices, kind);
     }
 
-    /// Renumbers the vertices in the order the triangles first use them, so that the corners
-    /// of a leaf's triangles share a few cache lines instead of scattering over the mesh.
-    fn number_vertices_by_first_use(&mut self) {
-        const UNSEEN: u32 = u32::MAX;
-        let mut new_index = vec![UNSEEN; self.packed.len()];
-        let mut old_index = Vec::with_capacity(self.packed.len());
-        for v in self.triangles.iter_mut().flatten() {
-            if new_index[*v as usize] == UNSEEN {
-                new_index[*v as usize] = old_index.len() as u32;
-                old_index.push(*v);
-            }
-            *v = new_index[*v as usize];
-        }
-        // Vertices no triangle uses keep their place after the others.
-        old_index
-            .extend((0..self.packed.len() as u32).filter(|&v| new_index[v as usize] == UNSEEN));
-        fn permute<T: Copy>(values: &mut Vec<T>, old_index: &[u32]) {
-            if !values.is_empty() {
-                *values = old_index.iter().map(|&v| values[v as usize]).collect();
-            }
-        }
-        permute(&mut self.packed, &old_index);
-        permute(&mut self.normals, &old_index);
-        permute(&mut self.uvs, &old_index);
-    }
-
-    fn clone_without_accel(&self) -> TriangleMesh {
-        TriangleMesh {
-            packed: self.packed.clone(),
-            normals: self.normals.clone(),
-            uvs: self.uvs.clone(),
-            triangles: self.triangles.clone(),
-            source: self.source.clone(),
-            accel: Accel::default(),
-            bounds: self.bounds,
-            closed: self.closed,
-        }
-    }
-
-    fn triangle_bounds(&self) -> Vec<Bounds3> {
-        self.triangles
+    /// Builds a `kind` structure over triangles given in the order the mesh was made from
+    /// (with their vertex indices, or none), and stores them in its order: in blocks, a
+    /// BVH's leaves padded to whole blocks; else indexed, in Morton order.
+    fn store(&mut self, corners: &[Corners], indices: &[[u32; 3]], kind: AccelKind) {
+        let bounds: Vec<Bounds3> = corners
             .iter()
-            .map(|t| Bounds3::from_points(t.iter().map(|&i| self.position(i))))
-            .collect()
+            .map(|c| {
+                let widened = c.map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+                Bounds3::from_points(widened)
+            })
+            .collect();
+        if kind != AccelKind::Bvh {
+            // The triangles of a cell then lie near each other in memory.
+            let order = morton_order(&bounds);
+            let sorted: Vec<Bounds3> = order.iter().map(|&s| bounds[s as usize]).collect();
+            // Vertices numbered in this order too, unless the mesh keeps its numbering.
+            let sorted_corners: Vec<Corners> = order.iter().map(|&s| corners[s as usize]).collect();
+            let sorted_indices: Vec<[u32; 3]> = match indices.is_empty() {
+                true => Vec::new(),
+                false => order.iter().map(|&s| indices[s as usize]).collect(),
+            };
+            let (vertices, triangles) =
+                index_corners(&sorted_corners, &sorted_indices, self.vertex_count);
+            self.accel = Accel::build(kind, &sorted, LEAF);
+            self.blocks = Vec::new();
+            self.vertices = vertices.iter().map(|&[x, y, z]| [x, y, z, 0.0]).collect();
+            self.indices = triangles;
+            self.source = order;
+            return;
+        }
+        let mut bvh = Bvh::build(&bounds, LEAF.max_leaf, LEAF.block);
+        let mut order = bvh.take_padded_order(LANES);
+        // Every triangle has a box, so every one is in the order; but keep any left out,
+        // after the leaves.
+        let mut listed = vec![false; corners.len()];
+        order
+            .iter()
+            .filter(|&&s| s != PAD)
+            .for_each(|&s| listed[s as usize] = true);
+        order.extend((0..corners.len() as u32).filter(|&s| !listed[s as usize]));
+        order.resize(order.len().next_multiple_of(LANES), PAD);
+        self.accel = Accel::Bvh(bvh);
+        self.vertices = Vec::new();
+        self.blocks = order
+            .chunks(LANES)
+            .map(|slots| {
+                // A padding lane repeats a triangle of its block: every lane holds numbers.
+                let filler = slots.iter().copied().find(|&s| s != PAD).unwrap_or(0);
+                let mut block = Block([[[0.0; LANES]; 3]; 3]);
+                for (lane, &s) in slots.iter().enumerate() {
+                    let c = &corners[if s == PAD { filler } else { s } as usize];
+                    for (k, corner) in c.iter().enumerate() {
+                        for (a, &v) in corner.iter().enumerate() {
+                            block.0[k][a][lane] = v;
+                        }
+                    }
+                }
+                block
+            })
+            .collect();
+        self.indices = if self.keeps_indices {
+            let index = |s: u32| {
+                if s == PAD {
+                    [0; 3]
+                } else {
+                    indices[s as usize]
+                }
+            };
+            order.iter().map(|&s| index(s)).collect()
+        } else {
+            Vec::new()
+        };
+        self.source = order;
     }
 
-    /// Bytes the mesh occupies: vertices, indices, attributes and the acceleration structure.
+    /// The triangles' corners, and the vertex indices the mesh was made with where it keeps
+    /// them (else none), in the order the mesh was made from.
+    fn in_source_order(&self) -> (Vec<Corners>, Vec<[u32; 3]>) {
+        let mut corners = vec![[[0.0; 3]; 3]; self.triangle_count];
+        let kept = if self.keeps_indices {
+            self.triangle_count
+        } else {
+            0
+        };
+        let mut indices = vec![[0; 3]; kept];
+        for (slot, &s) in self.source.iter().enumerate() {
+            if s != PAD {
+                corners[s as usize] = self.corners_f32(slot as u32);
+                if let Some(i) = indices.get_mut(s as usize) {
+                    *i = self.indices[slot];
+                }
+            }
+        }
+        (corners, indices)
+    }
+
+    /// Bytes the mesh occupies: corners, indices, attributes and the acceleration structure.
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of::<TriangleMesh>()
-            + self.packed.len() * std::mem::size_of::<[f32; 4]>()
+            + self.blocks.len() * std::mem::size_of::<Block>()
+            + self.vertices.len() * std::mem::size_of::<[f32; LANES]>()
+            + self.source.len() * std::mem::size_of::<u32>()
+            + self.indices.len() * std::mem::size_of::<[u32; 3]>()
             + self.normals.len() * std::mem::size_of::<Vec3>()
             + self.uvs.len() * std::mem::size_of::<[f64; 2]>()
-            + self.triangles.len() * std::mem::size_of::<[u32; 3]>()
-            + self.source.len() * std::mem::size_of::<u32>()
             + self.accel.memory_bytes()
     }
 
@@ -221,22 +331,11 @@ impl TriangleMesh {
     }
 
     pub fn triangle_count(&self) -> usize {
-        self.triangles.len()
+        self.triangle_count
     }
 
     pub fn vertex_count(&self) -> usize {
-        self.packed.len()
-    }
-
-    /// The position of vertex `vertex`.
-    pub fn position(&self, vertex: u32) -> Vec3 {
-        let [x, y, z, _] = self.packed[vertex as usize];
-        Vec3::new(x as f64, y as f64, z as f64)
-    }
-
-    /// The positions of all vertices, in the mesh's numbering.
-    pub fn positions(&self) -> impl ExactSizeIterator<Item = Vec3> + '_ {
-        (0..self.packed.len() as u32).map(|v| self.position(v))
+        self.vertex_count
     }
 
     /// Per-vertex shading normals; empty when the mesh is flat-shaded.
@@ -249,10 +348,36 @@ impl TriangleMesh {
         &self.uvs
     }
 
-    /// The triangles, in the order the mesh stores them (a BVH's leaf order), which is the
-    /// order hits name them in ([`HitRecord::part`]).
-    pub fn triangles(&self) -> &[[u32; 3]] {
-        &self.triangles
+    /// The stored triangles, each as the part hits name it by ([`HitRecord::part`]) and its
+    /// corners.
+    pub fn triangles(&self) -> impl Iterator<Item = (u32, [Vec3; 3])> + '_ {
+        (0..self.source.len() as u32)
+            .filter(|&part| self.source[part as usize] != PAD)
+            .map(|part| (part, self.triangle(part)))
+    }
+
+    /// The corners of stored triangle `part`.
+    pub fn triangle(&self, part: u32) -> [Vec3; 3] {
+        self.corners_f32(part)
+            .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+    }
+
+    fn corners_f32(&self, part: u32) -> Corners {
+        if self.blocks.is_empty() {
+            return self.indices[part as usize].map(|v| {
+                let [x, y, z, _] = self.vertices[v as usize];
+                [x, y, z]
+            });
+        }
+        let (block, lane) = (part as usize / LANES, part as usize % LANES);
+        let b = &self.blocks[block].0;
+        [0, 1, 2].map(|k| [0, 1, 2].map(|a| b[k][a][lane]))
+    }
+
+    /// The vertex indices of stored triangle `part`, where the mesh keeps them (it has
+    /// normals or uvs, or was made by [`TriangleMesh::new_keeping_indices`]).
+    pub fn vertex_indices(&self, part: u32) -> Option<[u32; 3]> {
+        self.keeps_indices.then(|| self.indices[part as usize])
     }
 
     /// Where stored triangle `part` was in the list the mesh was made from.
@@ -260,12 +385,19 @@ impl TriangleMesh {
         self.source[part as usize]
     }
 
-    pub fn bounds(&self) -> Bounds3 {
-        self.bounds
+    /// The mesh as positions and vertex indices, the triangles in the order it was made
+    /// from. Where the mesh keeps its indices they are the ones it was made with (a vertex
+    /// no triangle uses comes back at the origin); else the vertices are the distinct corner
+    /// positions, numbered as the triangles first use them.
+    pub fn indexed(&self) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let (corners, indices) = self.in_source_order();
+        let (vertices, triangles) = index_corners(&corners, &indices, self.vertex_count);
+        let widened = |p: &[f32; 3]| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+        (vertices.iter().map(widened).collect(), triangles)
     }
 
-    fn vertices(&self, index: u32) -> [Vec3; 3] {
-        self.triangles[index as usize].map(|i| self.position(i))
+    pub fn bounds(&self) -> Bounds3 {
+        self.bounds
     }
 
     /// The nearest hit in (0, t_max).
@@ -273,9 +405,9 @@ impl TriangleMesh {
         // Prepared at the first leaf: most rays that miss never reach one.
         let mut sheared = None;
         let mut best = None;
-        self.visit_blocks::<true>(ray, t_max, |ids, count, t_max| {
+        self.visit_blocks::<true>(ray, t_max, |block, parts, count, t_max| {
             let r = sheared.get_or_insert_with(|| ShearedRay::new(ray));
-            if let Some(hit) = self.intersect_block(r, ray, ids, count, *t_max) {
+            if let Some(hit) = self.intersect_block(r, ray, block, parts, count, *t_max) {
                 *t_max = hit.t;
                 best = Some(hit);
             }
@@ -288,50 +420,53 @@ impl TriangleMesh {
     pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
         let mut sheared = None;
         let mut found = None;
-        self.visit_blocks::<false>(ray, t_max, |ids, count, t_max| {
+        self.visit_blocks::<false>(ray, t_max, |block, parts, count, t_max| {
             let r = sheared.get_or_insert_with(|| ShearedRay::new(ray));
-            found = self.intersect_block(r, ray, ids, count, *t_max);
+            found = self.intersect_block(r, ray, block, parts, count, *t_max);
             found.is_none()
         });
         found
     }
 
-    /// Hands `test(ids, count, t_max)` blocks of up to four triangles the ray may meet,
-    /// roughly nearest first if `NEAREST_FIRST`, until it returns false. Lanes past `count`
-    /// repeat the last triangle.
+    /// Hands `test(block, parts, count, t_max)` blocks of up to four triangles the ray may
+    /// meet, roughly nearest first if `NEAREST_FIRST`, until it returns false. Lanes from
+    /// `count` on are to be ignored.
     #[inline(always)]
     fn visit_blocks<const NEAREST_FIRST: bool>(
         &self,
         ray: &Ray,
         t_max: f64,
-        mut test: impl FnMut([u32; 4], usize, &mut f64) -> bool,
+        mut test: impl FnMut(&Block, [u32; LANES], usize, &mut f64) -> bool,
     ) {
         if let Accel::Bvh(bvh) = &self.accel {
-            // Leaves are runs of the stored triangles: no index to read per triangle.
+            // A leaf is a run of slots starting a block: its blocks are read in place.
             let visit_run = |run: Range<usize>, t_max: &mut f64| {
-                let last = run.end as u32 - 1;
-                for base in run.step_by(4).map(|b| b as u32) {
-                    let ids = [0, 1, 2, 3].map(|lane| (base + lane).min(last));
-                    let count = (last - base + 1).min(4) as usize;
-                    if !test(ids, count, t_max) {
+                for base in run.clone().step_by(LANES) {
+                    debug_assert!(base % LANES == 0 && base / LANES < self.blocks.len());
+                    // SAFETY: the BVH's runs lie within the slots it ordered, all stored.
+                    let block = unsafe { self.blocks.get_unchecked(base / LANES) };
+                    let parts = [0, 1, 2, 3].map(|lane| (base + lane) as u32);
+                    if !test(block, parts, (run.end - base).min(LANES), t_max) {
                         return false;
                     }
                 }
                 true
             };
+            let items = LeafItems::packed(&self.blocks, LANES);
             if NEAREST_FIRST {
-                bvh.traverse_runs(ray, t_max, &self.triangles, visit_run);
+                bvh.traverse_runs(ray, t_max, items, visit_run);
             } else {
-                bvh.traverse_runs_any_order(ray, t_max, &self.triangles, visit_run);
+                bvh.traverse_runs_any_order(ray, t_max, items, visit_run);
             }
             return;
         }
         // A triangle met again in another cell is simply tested again: no stamps needed.
         self.accel.traverse_repeating(ray, t_max, |items, t_max| {
-            for block in items.chunks(4) {
-                let last = block.len() - 1;
-                let ids = [0, 1, 2, 3].map(|lane| block[lane.min(last)]);
-                if !test(ids, block.len(), t_max) {
+            for chunk in items.chunks(LANES) {
+                let last = chunk.len() - 1;
+                let parts = [0, 1, 2, 3].map(|lane| chunk[lane.min(last)]);
+                // Gathered into a block on the stack: the test then reads every block alike.
+                if !test(&self.gather(parts), parts, chunk.len(), t_max) {
                     return false;
                 }
             }
@@ -339,22 +474,21 @@ impl TriangleMesh {
         });
     }
 
-    /// The corners of four triangles in lanes: `[corner][axis]`.
+    /// A block of four triangles from anywhere in an indexed mesh.
     #[inline(always)]
-    fn corners(&self, ids: [u32; 4]) -> [[F4; 3]; 3] {
-        debug_assert!(ids.iter().all(|&i| (i as usize) < self.triangles.len()));
-        // SAFETY: ids come from the structure built over these triangles.
-        let tri = |lane: usize| unsafe { *self.triangles.get_unchecked(ids[lane] as usize) };
+    fn gather(&self, parts: [u32; LANES]) -> Block {
+        debug_assert!(parts.iter().all(|&p| (p as usize) < self.indices.len()));
+        // SAFETY: parts come from the structure built over these triangles.
+        let tri = |lane: usize| unsafe { *self.indices.get_unchecked(parts[lane] as usize) };
         let (t0, t1, t2, t3) = (tri(0), tri(1), tri(2), tri(3));
-        let corner = |k: usize| {
-            let p = |t: [u32; 3]| {
-                // SAFETY: every index was checked against the vertex count in `new`.
-                F4::load(unsafe { self.packed.get_unchecked(t[k] as usize) })
-            };
+        let mut block = Block([[[0.0; LANES]; 3]; 3]);
+        for k in 0..3 {
+            // SAFETY: every index was checked against the vertex count in `new`.
+            let p = |t: [u32; 3]| F4::load(unsafe { self.vertices.get_unchecked(t[k] as usize) });
             let [x, y, z, _] = F4::transpose([p(t0), p(t1), p(t2), p(t3)]);
-            [x, y, z]
-        };
-        [corner(0), corner(1), corner(2)]
+            block.0[k] = [x.to_array(), y.to_array(), z.to_array()];
+        }
+        block
     }
 
     /// The nearest hit among up to four triangles, tested together; lanes from `count` on
@@ -364,16 +498,16 @@ impl TriangleMesh {
         &self,
         r: &ShearedRay,
         ray: &Ray,
-        block: [u32; 4],
+        block: &Block,
+        parts: [u32; LANES],
         count: usize,
         t_max: f64,
     ) -> Option<HitRecord> {
-        let corners = &self.corners(block);
         // One copy of the test per axis the ray runs along, so the permutation is static.
         match r.axes[2] {
-            0 => self.intersect_block_along::<0>(r, ray, corners, block, count, t_max),
-            1 => self.intersect_block_along::<1>(r, ray, corners, block, count, t_max),
-            _ => self.intersect_block_along::<2>(r, ray, corners, block, count, t_max),
+            0 => self.intersect_block_along::<0>(r, ray, block, parts, count, t_max),
+            1 => self.intersect_block_along::<1>(r, ray, block, parts, count, t_max),
+            _ => self.intersect_block_along::<2>(r, ray, block, parts, count, t_max),
         }
     }
 
@@ -382,17 +516,17 @@ impl TriangleMesh {
         &self,
         r: &ShearedRay,
         ray: &Ray,
-        corners: &[[F4; 3]; 3],
-        block: [u32; 4],
+        block: &Block,
+        parts: [u32; LANES],
         count: usize,
         t_max: f64,
     ) -> Option<HitRecord> {
         let (kx, ky) = ((KZ + 1) % 3, (KZ + 2) % 3);
         let corner = |k: usize| {
-            let p = &corners[k];
-            let x = p[kx].sub(r.origin[0]);
-            let y = p[ky].sub(r.origin[1]);
-            let z = p[KZ].sub(r.origin[2]);
+            let p = &block.0[k];
+            let x = F4::load(&p[kx]).sub(r.origin[0]);
+            let y = F4::load(&p[ky]).sub(r.origin[1]);
+            let z = F4::load(&p[KZ]).sub(r.origin[2]);
             // Shear so the ray is the +z axis.
             [x.add(r.shear[0].mul(z)), y.add(r.shear[1].mul(z)), z]
         };
@@ -452,7 +586,7 @@ impl TriangleMesh {
                         t: t[lane] as f64,
                         u: (e1[lane] / det[lane]) as f64,
                         v: (e2[lane] / det[lane]) as f64,
-                        part: block[lane],
+                        part: parts[lane],
                     });
                 }
             }
@@ -462,12 +596,12 @@ impl TriangleMesh {
             let lane = on_edge.trailing_zeros() as usize;
             on_edge &= on_edge - 1;
             let limit = best.map_or(t_max, |h| h.t);
-            if let Some((t, b1, b2)) = intersect_triangle(ray, limit, self.vertices(block[lane])) {
+            if let Some((t, b1, b2)) = intersect_triangle(ray, limit, self.triangle(parts[lane])) {
                 best = Some(HitRecord {
                     t,
                     u: b1,
                     v: b2,
-                    part: block[lane],
+                    part: parts[lane],
                 });
             }
         }
@@ -475,7 +609,7 @@ impl TriangleMesh {
     }
 
     pub fn surface(&self, _ray: &Ray, hit: &HitRecord) -> SurfaceGeometry {
-        let [p0, p1, p2] = self.vertices(hit.part);
+        let [p0, p1, p2] = self.triangle(hit.part);
         let (b1, b2) = (hit.u, hit.v);
         let b0 = 1.0 - b1 - b2;
         let p = p0 * b0 + p1 * b1 + p2 * b2;
@@ -483,7 +617,8 @@ impl TriangleMesh {
         // an origin rounded to f32, and must stay clear of the triangle it leaves.
         let p_error = ((p0 * b0).abs() + (p1 * b1).abs() + (p2 * b2).abs()) * gamma_f32(7) as f64;
         let mut n = (p1 - p0).cross(p2 - p0).normalized();
-        let idx = self.triangles[hit.part as usize];
+        // Kept wherever there are normals or uvs.
+        let idx = self.vertex_indices(hit.part).unwrap_or_default();
         let shading_n = if self.normals.is_empty() {
             n
         } else {
@@ -546,18 +681,79 @@ impl ShearedRay {
     }
 }
 
+/// Vertices and vertex indices for triangles given by their corners. With the indices the
+/// mesh was made with, its `vertex_count` vertices (one no triangle uses is left at the
+/// origin); without, the distinct corner positions, numbered as the triangles first use them.
+fn index_corners(
+    corners: &[Corners],
+    indices: &[[u32; 3]],
+    vertex_count: usize,
+) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
+    if !indices.is_empty() {
+        let mut vertices = vec![[0.0; 3]; vertex_count];
+        for (c, t) in corners.iter().zip(indices) {
+            for k in 0..3 {
+                vertices[t[k] as usize] = c[k];
+            }
+        }
+        return (vertices, indices.to_vec());
+    }
+    let mut numbers: std::collections::HashMap<[u32; 3], u32> = Default::default();
+    let mut vertices = Vec::new();
+    let triangles = corners
+        .iter()
+        .map(|c| {
+            c.map(|p| {
+                *numbers.entry(p.map(f32::to_bits)).or_insert_with(|| {
+                    vertices.push(p);
+                    vertices.len() as u32 - 1
+                })
+            })
+        })
+        .collect();
+    (vertices, triangles)
+}
+
+/// The items sorted by the Morton code of their boxes' centres (Z-order, ten bits per axis):
+/// items near each other in space come near each other in the list.
+fn morton_order(bounds: &[Bounds3]) -> Vec<u32> {
+    let all = bounds.iter().fold(Bounds3::default(), |b, i| b.union(i));
+    let extent = all.max - all.min;
+    // Bits 0, 3, 6, … of the result are those of `v`.
+    let spread = |v: u32| {
+        let mut x = v & 0x3FF;
+        x = (x | (x << 16)) & 0x0300_00FF;
+        x = (x | (x << 8)) & 0x0300_F00F;
+        x = (x | (x << 4)) & 0x030C_30C3;
+        (x | (x << 2)) & 0x0924_9249
+    };
+    let code = |b: &Bounds3| {
+        let c = (b.min + b.max) * 0.5 - all.min;
+        let cell = |a: usize| {
+            let f = if extent[a] > 0.0 {
+                c[a] / extent[a]
+            } else {
+                0.0
+            };
+            (f * 1023.0).clamp(0.0, 1023.0) as u32
+        };
+        spread(cell(0)) | (spread(cell(1)) << 1) | (spread(cell(2)) << 2)
+    };
+    let mut order: Vec<u32> = (0..bounds.len() as u32).collect();
+    order.sort_by_cached_key(|&i| code(&bounds[i as usize]));
+    order
+}
+
 /// Whether every edge is shared by exactly two triangles. Vertices are matched by position,
 /// since file formats split a corner into several vertices where normals or uvs differ.
-fn is_closed(positions: &[Vec3], triangles: &[[u32; 3]]) -> bool {
+fn is_closed(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> bool {
     use std::collections::HashMap;
-    let mut canonical: HashMap<[u64; 3], u32> = HashMap::new();
+    let mut canonical: HashMap<[u32; 3], u32> = HashMap::new();
     let ids: Vec<u32> = positions
         .iter()
         .map(|p| {
             let next = canonical.len() as u32;
-            *canonical
-                .entry([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()])
-                .or_insert(next)
+            *canonical.entry(p.map(f32::to_bits)).or_insert(next)
         })
         .collect();
     let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
@@ -669,6 +865,82 @@ mod tests {
                 assert!(hit1.is_some() || hit2.is_some(), "gap at s = {s}");
             }
         }
+    }
+
+    /// A bumpy square of `n` × `n` quads, two triangles each, its coordinates exact in f32.
+    fn sheet(n: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let positions = (0..=n)
+            .flat_map(|j| (0..=n).map(move |i| (i, j)))
+            .map(|(i, j)| Vec3::new(i as f64, j as f64, ((i * 7 + j * 3) % 5) as f64 * 0.125))
+            .collect();
+        let v = |i: u32, j: u32| j * (n + 1) + i;
+        let triangles = (0..n)
+            .flat_map(|j| (0..n).map(move |i| (i, j)))
+            .flat_map(|(i, j)| {
+                [
+                    [v(i, j), v(i + 1, j), v(i + 1, j + 1)],
+                    [v(i, j), v(i + 1, j + 1), v(i, j + 1)],
+                ]
+            })
+            .collect();
+        (positions, triangles)
+    }
+
+    #[test]
+    fn every_layout_keeps_the_triangles_and_their_numbering() {
+        let (positions, triangles) = sheet(13);
+        let normals = vec![Vec3::Z; positions.len()];
+        let kept =
+            TriangleMesh::new(positions.clone(), triangles.clone(), normals, vec![]).unwrap();
+        let bare = TriangleMesh::new(positions.clone(), triangles.clone(), vec![], vec![]).unwrap();
+        let corners = |t: &[u32; 3]| t.map(|i| positions[i as usize]);
+        for kind in [
+            AccelKind::Bvh,
+            AccelKind::Grid,
+            AccelKind::Octree,
+            AccelKind::None,
+        ] {
+            // Back and forth between blocks and the indexed layout.
+            let kept = kept
+                .with_accel(kind)
+                .with_accel(AccelKind::Octree)
+                .with_accel(kind);
+            assert_eq!(
+                kept.indexed(),
+                (positions.clone(), triangles.clone()),
+                "{kind}"
+            );
+            let bare = bare.with_accel(kind);
+            let (vertices, tris) = bare.indexed();
+            assert_eq!(
+                vertices.len(),
+                positions.len(),
+                "{kind}: shared corners merged"
+            );
+            for (t, u) in triangles.iter().zip(&tris) {
+                assert_eq!(corners(t), u.map(|i| vertices[i as usize]), "{kind}");
+            }
+            for mesh in [&kept, &bare] {
+                assert_eq!(mesh.triangles().count(), triangles.len(), "{kind}");
+                for (part, tri) in mesh.triangles() {
+                    let source = mesh.source_triangle(part) as usize;
+                    assert_eq!(tri, corners(&triangles[source]), "{kind}");
+                }
+            }
+            let (part, _) = kept.triangles().nth(5).unwrap();
+            let source = kept.source_triangle(part) as usize;
+            assert_eq!(kept.vertex_indices(part), Some(triangles[source]), "{kind}");
+            assert_eq!(bare.vertex_indices(part), None, "{kind}");
+        }
+    }
+
+    #[test]
+    fn a_bvh_mesh_takes_at_most_64_bytes_a_triangle() {
+        // The budget of the acceleration issue, vertices, indices and nodes included.
+        let (positions, triangles) = sheet(100);
+        let mesh = TriangleMesh::new(positions, triangles, vec![], vec![]).unwrap();
+        let per_triangle = mesh.memory_bytes() as f64 / mesh.triangle_count() as f64;
+        assert!(per_triangle <= 64.0, "{per_triangle} bytes a triangle");
     }
 
     #[test]
