@@ -17,7 +17,7 @@
 
 #[cfg(target_arch = "x86_64")]
 use super::ray_f32::BoxRayAvx;
-use super::ray_f32::{round_down, round_up, BoxRay};
+use super::ray_f32::{round_down, round_up, round_up_distance, BoxRay};
 use super::simd::F4;
 use crate::math::{Bounds3, Ray};
 use std::mem::MaybeUninit;
@@ -457,7 +457,7 @@ impl Bvh {
         test: impl Fn(&[[f32; WIDTH]; 6], f32) -> ([f32; WIDTH], u32),
     ) {
         let mut t_max = t_max;
-        let mut far = round_up(t_max);
+        let mut far = round_up_distance(t_max);
         // Uninitialised: only entries below `top`, all written first, are read.
         let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK];
         let mut top = 0usize;
@@ -469,7 +469,7 @@ impl Bvh {
                 if !visit(start..start + count, &mut t_max) {
                     return;
                 }
-                far = round_up(t_max);
+                far = round_up_distance(t_max);
             } else {
                 debug_assert!((current as usize) < self.nodes.len());
                 // SAFETY: interior references are indices of nodes, written by `flatten`.

@@ -9,8 +9,9 @@
 //! the cells the ray touches up to rounding, which the margin items are filed with covers.
 
 use super::mailbox::{new_owner, Mailbox};
-use super::{nearest, split_off_large};
+use super::{append_padded, nearest, split_off_large};
 use crate::math::{Bounds3, Ray, Vec3};
+use std::ops::Range;
 
 /// Cells per item.
 const LAMBDA: f64 = 1.5;
@@ -26,6 +27,8 @@ pub struct Grid {
     all_bounds: Bounds3,
     /// Items as large as the scene, tested by every ray (see [`split_off_large`]).
     large: Vec<u32>,
+    /// After [`Grid::take_padded_runs`], the large items' run: the first `large_run` slots.
+    large_run: usize,
     resolution: [usize; 3],
     cell_size: Vec3,
     /// 1 / cell_size, or 0 along a flat axis: cells are found by a product, not a quotient.
@@ -54,6 +57,7 @@ impl Grid {
             bounds,
             all_bounds,
             large,
+            large_run: 0,
             resolution: [1; 3],
             cell_size: Vec3::ONE,
             inv_cell_size: Vec3::ONE,
@@ -170,8 +174,18 @@ impl Grid {
     ///
     /// Two walks in step: one over macro cells, which crosses an empty one in a single step,
     /// and one over the cells of each macro cell that holds anything.
-    pub fn traverse(&self, ray: &Ray, t_max: f64, visit: impl FnMut(&[u32], &mut f64) -> bool) {
-        self.walk::<true>(ray, t_max, visit);
+    pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
+        let mut t_max = t_max;
+        // First, so that a hit on them (the ground, say) prunes the walk.
+        if !self.large.is_empty() && !visit(&self.large, &mut t_max) {
+            return;
+        }
+        let mut mailbox = None;
+        self.walk(ray, t_max, |first, end, t_max| {
+            mailbox
+                .get_or_insert_with(|| Mailbox::start(self.owner, self.item_count))
+                .visit_untested(self.run(first, end), t_max, &mut visit)
+        });
     }
 
     /// [`Grid::traverse`] without mailboxing: an item in several cells may be handed over
@@ -181,24 +195,69 @@ impl Grid {
         &self,
         ray: &Ray,
         t_max: f64,
-        visit: impl FnMut(&[u32], &mut f64) -> bool,
-    ) {
-        self.walk::<false>(ray, t_max, visit);
-    }
-
-    #[inline(always)]
-    fn walk<const UNIQUE: bool>(
-        &self,
-        ray: &Ray,
-        t_max: f64,
         mut visit: impl FnMut(&[u32], &mut f64) -> bool,
     ) {
         let mut t_max = t_max;
-        // First, so that a hit on them (the ground, say) prunes the walk.
         if !self.large.is_empty() && !visit(&self.large, &mut t_max) {
             return;
         }
-        if self.items.is_empty() {
+        self.walk(ray, t_max, |first, end, t_max| {
+            visit(self.run(first, end), t_max)
+        });
+    }
+
+    /// Hands the caller the items of the large run and of every cell, each padded with
+    /// `pad` entries to a whole number of `block`s and starting a block, in place of the
+    /// grid's own lists: for a caller that stores its items so, as a mesh stores its
+    /// triangles in blocks. Only [`Grid::traverse_runs`] may be used afterwards.
+    pub fn take_padded_runs(&mut self, block: usize, pad: u32) -> Vec<u32> {
+        let mut padded = Vec::with_capacity(self.items.len() * 2);
+        append_padded(&mut padded, &self.large, block, pad);
+        self.large_run = padded.len();
+        let mut starts = Vec::with_capacity(self.starts.len());
+        for c in 0..self.starts.len() - 1 {
+            starts.push(padded.len() as u32);
+            let items = &self.items[self.starts[c] as usize..self.starts[c + 1] as usize];
+            append_padded(&mut padded, items, block, pad);
+        }
+        starts.push(padded.len() as u32);
+        self.large = Vec::new();
+        self.starts = starts;
+        self.items = Vec::new();
+        padded
+    }
+
+    /// [`Grid::traverse_repeating`] after [`Grid::take_padded_runs`], handing each run as
+    /// its range of positions in the padded list (pads included).
+    #[inline]
+    pub fn traverse_runs(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        mut visit: impl FnMut(Range<usize>, &mut f64) -> bool,
+    ) {
+        let mut t_max = t_max;
+        if self.large_run > 0 && !visit(0..self.large_run, &mut t_max) {
+            return;
+        }
+        self.walk(ray, t_max, |first, end, t_max| visit(first..end, t_max));
+    }
+
+    /// Cell items `first..end`.
+    #[inline(always)]
+    fn run(&self, first: usize, end: usize) -> &[u32] {
+        debug_assert!(first <= end && end <= self.items.len());
+        // SAFETY: `starts` holds ascending offsets into `items`.
+        unsafe { self.items.get_unchecked(first..end) }
+    }
+
+    /// Walks the cells the ray crosses in order, handing `hand(first, end, t_max)` the run
+    /// `first..end` of the items of each one that holds any, until it returns false.
+    #[inline(always)]
+    fn walk(&self, ray: &Ray, t_max: f64, mut hand: impl FnMut(usize, usize, &mut f64) -> bool) {
+        let mut t_max = t_max;
+        // Nothing filed in any cell.
+        if self.starts.last() == Some(&0) {
             return;
         }
         let walk = Walk::new(self, ray);
@@ -219,7 +278,6 @@ impl Grid {
         // entered this macro cell at `t_block` through a wall across `entered_along`.
         let mut walking = true;
         let (mut t_block, mut entered_along) = (t_enter, 0);
-        let mut mailbox = None;
         loop {
             if self.macro_full[m] {
                 if !walking {
@@ -240,17 +298,7 @@ impl Grid {
                         )
                     };
                     if first < end {
-                        debug_assert!(end <= self.items.len());
-                        // SAFETY: `starts` holds ascending offsets into `items`.
-                        let items = unsafe { self.items.get_unchecked(first..end) };
-                        let go_on = if UNIQUE {
-                            mailbox
-                                .get_or_insert_with(|| Mailbox::start(self.owner, self.item_count))
-                                .visit_untested(items, &mut t_max, &mut visit)
-                        } else {
-                            visit(items, &mut t_max)
-                        };
-                        if !go_on {
+                        if !hand(first, end, &mut t_max) {
                             return;
                         }
                         limit = t_max.min(t_exit);

@@ -202,6 +202,12 @@ impl Accel {
     }
 }
 
+/// Appends `items` to `list`, then `pad` entries up to a whole number of `block`s.
+fn append_padded(list: &mut Vec<u32>, items: &[u32], block: usize, pad: u32) {
+    list.extend_from_slice(items);
+    list.resize(list.len().next_multiple_of(block), pad);
+}
+
 /// The axis of the smallest of three times, and that time (the grid's and the octree's next
 /// wall). Written as selects, not branches: which wall comes next is a coin toss the CPU
 /// cannot predict.

@@ -6,9 +6,10 @@
 //! visited front to back. Items filed in several cells are mailboxed.
 
 use super::mailbox::{new_owner, Mailbox};
-use super::{nearest, split_off_large};
+use super::{append_padded, nearest, split_off_large};
 use crate::math::{Bounds3, Ray, Vec3};
 use std::mem::MaybeUninit;
+use std::ops::Range;
 
 const LEAF_ITEMS: usize = 8;
 const MAX_DEPTH: usize = 16;
@@ -49,9 +50,13 @@ pub struct Octree {
     all_bounds: Bounds3,
     /// Items as large as the scene, tested by every ray (see [`split_off_large`]).
     large: Vec<u32>,
+    /// After [`Octree::take_padded_runs`], the large items' run: the first `large_run` slots.
+    large_run: usize,
     /// Cell `id` is `blocks[id / 8].0[id % 8]`; the root is cell 0, alone in its block.
     blocks: Vec<Siblings>,
     items: Vec<u32>,
+    /// Some cell holds an item.
+    has_items: bool,
     item_count: usize,
     owner: u64,
 }
@@ -87,8 +92,10 @@ impl Octree {
             bounds,
             all_bounds: bounds.union(&union(&large)),
             large,
+            large_run: 0,
             blocks: vec![EMPTY_BLOCK],
             items: Vec::new(),
+            has_items: false,
             item_count: item_bounds.len(),
             owner: new_owner(),
         };
@@ -100,6 +107,7 @@ impl Octree {
         let filed: Vec<Bounds3> = item_bounds.iter().map(|b| b.expanded(margin)).collect();
         tree.bounds = bounds.expanded(margin);
         tree.build_node(0, tree.bounds.min, tree.bounds.max, bounded, 0, &filed);
+        tree.has_items = !tree.items.is_empty();
         tree
     }
 
@@ -181,8 +189,18 @@ impl Octree {
 
     /// Visits the leaves the ray crosses front to back, handing `visit` their untested items
     /// (see [`super::Accel::traverse`]).
-    pub fn traverse(&self, ray: &Ray, t_max: f64, visit: impl FnMut(&[u32], &mut f64) -> bool) {
-        self.descend::<true>(ray, t_max, visit);
+    pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
+        let mut t_max = t_max;
+        // First, so that a hit on them (the ground, say) prunes the descent.
+        if !self.large.is_empty() && !visit(&self.large, &mut t_max) {
+            return;
+        }
+        let mut mailbox = None;
+        self.descend(ray, t_max, |run, t_max| {
+            mailbox
+                .get_or_insert_with(|| Mailbox::start(self.owner, self.item_count))
+                .visit_untested(&self.items[run], t_max, &mut visit)
+        });
     }
 
     /// [`Octree::traverse`] without mailboxing: an item in several cells may be handed over
@@ -192,25 +210,59 @@ impl Octree {
         &self,
         ray: &Ray,
         t_max: f64,
-        visit: impl FnMut(&[u32], &mut f64) -> bool,
-    ) {
-        self.descend::<false>(ray, t_max, visit);
-    }
-
-    #[inline(always)]
-    fn descend<const UNIQUE: bool>(
-        &self,
-        ray: &Ray,
-        t_max: f64,
         mut visit: impl FnMut(&[u32], &mut f64) -> bool,
     ) {
         let mut t_max = t_max;
-        // First, so that a hit on them (the ground, say) prunes the descent.
         if !self.large.is_empty() && !visit(&self.large, &mut t_max) {
             return;
         }
+        self.descend(ray, t_max, |run, t_max| visit(&self.items[run], t_max));
+    }
+
+    /// Hands the caller the items of the large run and of every leaf, each padded with
+    /// `pad` entries to a whole number of `block`s and starting a block, in place of the
+    /// octree's own lists: for a caller that stores its items so, as a mesh stores its
+    /// triangles in blocks. Only [`Octree::traverse_runs`] may be used afterwards.
+    pub fn take_padded_runs(&mut self, block: usize, pad: u32) -> Vec<u32> {
+        let mut padded = Vec::with_capacity(self.items.len() * 2);
+        append_padded(&mut padded, &self.large, block, pad);
+        self.large_run = padded.len();
+        for siblings in &mut self.blocks {
+            for node in siblings.0.iter_mut().filter(|n| n.info & LEAF != 0) {
+                let (first, count) = (node.first as usize, (node.info & !LEAF) as usize);
+                node.first = padded.len() as u32;
+                append_padded(&mut padded, &self.items[first..first + count], block, pad);
+            }
+        }
+        self.large = Vec::new();
+        self.has_items = !padded.is_empty();
+        self.items = Vec::new();
+        padded
+    }
+
+    /// [`Octree::traverse_repeating`] after [`Octree::take_padded_runs`], handing each run
+    /// as its range of positions in the padded list (pads left out).
+    #[inline]
+    pub fn traverse_runs(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        mut visit: impl FnMut(Range<usize>, &mut f64) -> bool,
+    ) {
+        let mut t_max = t_max;
+        if self.large_run > 0 && !visit(0..self.large_run, &mut t_max) {
+            return;
+        }
+        self.descend(ray, t_max, visit);
+    }
+
+    /// Visits the leaves the ray crosses front to back, handing `hand(run, t_max)` the
+    /// range of each one's items in `items`, until it returns false.
+    #[inline(always)]
+    fn descend(&self, ray: &Ray, t_max: f64, mut hand: impl FnMut(Range<usize>, &mut f64) -> bool) {
+        let mut t_max = t_max;
         // The root's own entry and exit test below stands for a test of the bounds.
-        if self.items.is_empty() {
+        if !self.has_items {
             return;
         }
         // As Revelles et al. do, mirror the ray about the tree's centre along each axis it
@@ -231,7 +283,6 @@ impl Octree {
             t0[a] = (lo[a] - o) * inv;
             t1[a] = (hi[a] - o) * inv;
         }
-        let mut mailbox = None;
         // Uninitialised: only entries below `top`, all written first, are read.
         let mut stack = [MaybeUninit::<(u32, [f64; 3], [f64; 3])>::uninit(); STACK];
         stack[0].write((0, t0, t1));
@@ -252,15 +303,7 @@ impl Octree {
             let node = self.node(index as usize);
             if node.info & LEAF != 0 {
                 let start = node.first as usize;
-                let items = &self.items[start..start + (node.info & !LEAF) as usize];
-                let go_on = if UNIQUE {
-                    mailbox
-                        .get_or_insert_with(|| Mailbox::start(self.owner, self.item_count))
-                        .visit_untested(items, &mut t_max, &mut visit)
-                } else {
-                    visit(items, &mut t_max)
-                };
-                if !go_on {
+                if !hand(start..start + (node.info & !LEAF) as usize, &mut t_max) {
                     return;
                 }
                 continue;

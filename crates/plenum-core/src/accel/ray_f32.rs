@@ -34,6 +34,15 @@ pub fn round_up(x: f64) -> f32 {
     }
 }
 
+/// [`round_up`] for a distance, never negative (nor NaN): stepping up is then adding one to
+/// the bits, without the cases of a negative, infinite or NaN `x`. Infinity stays infinite.
+#[inline(always)]
+pub fn round_up_distance(x: f64) -> f32 {
+    debug_assert!(x >= 0.0);
+    let f = x as f32;
+    f32::from_bits(f.to_bits() + u32::from((f as f64) < x))
+}
+
 /// A ray prepared for slab tests against four or eight boxes at once.
 pub struct BoxRay {
     /// The origin rounded up, for the distances to min planes, and down, for max planes:
@@ -229,6 +238,25 @@ impl BoxRayAvx {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn distances_round_up_as_any_number_does() {
+        use super::{round_up, round_up_distance};
+        let third = 1.0 / 3.0;
+        for x in [
+            0.0,
+            1e-300,
+            third,
+            1.0,
+            1e30,
+            f32::MAX as f64,
+            3.5e38,
+            1e300,
+            f64::INFINITY,
+        ] {
+            assert_eq!(round_up_distance(x).to_bits(), round_up(x).to_bits(), "{x}");
+        }
+    }
+
     use super::*;
     use crate::math::Vec3;
     use crate::sampling::Rng;

@@ -103,22 +103,6 @@ mod imp {
         pub fn eq(self, o: F4) -> u32 {
             unsafe { _mm_movemask_ps(_mm_cmpeq_ps(self.0, o.0)) as u32 }
         }
-        /// Rows to columns: lane j of output i is lane i of input j.
-        #[inline(always)]
-        pub fn transpose(rows: [F4; 4]) -> [F4; 4] {
-            unsafe {
-                let t0 = _mm_unpacklo_ps(rows[0].0, rows[1].0);
-                let t1 = _mm_unpacklo_ps(rows[2].0, rows[3].0);
-                let t2 = _mm_unpackhi_ps(rows[0].0, rows[1].0);
-                let t3 = _mm_unpackhi_ps(rows[2].0, rows[3].0);
-                [
-                    F4(_mm_movelh_ps(t0, t1)),
-                    F4(_mm_movehl_ps(t1, t0)),
-                    F4(_mm_movelh_ps(t2, t3)),
-                    F4(_mm_movehl_ps(t3, t2)),
-                ]
-            }
-        }
     }
 }
 
@@ -210,11 +194,6 @@ mod imp {
         pub fn eq(self, o: F4) -> u32 {
             mask(|i| self.0[i] == o.0[i])
         }
-        /// Rows to columns: lane j of output i is lane i of input j.
-        #[inline(always)]
-        pub fn transpose(rows: [F4; 4]) -> [F4; 4] {
-            std::array::from_fn(|i| F4(std::array::from_fn(|j| rows[j].0[i])))
-        }
     }
 }
 
@@ -242,8 +221,5 @@ mod tests {
         // NaN lanes take the second operand, which the slab test relies on.
         assert_eq!(a.min(b).to_array()[3], 2.0);
         assert_eq!(a.max(b).to_array()[3], 2.0);
-        let rows = [0, 1, 2, 3].map(|i| F4::from_array([0, 1, 2, 3].map(|j| (4 * i + j) as f32)));
-        let cols = F4::transpose(rows);
-        assert_eq!(cols[1].to_array(), [1.0, 5.0, 9.0, 13.0]);
     }
 }

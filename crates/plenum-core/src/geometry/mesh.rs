@@ -11,7 +11,7 @@
 //! per-vertex materials).
 
 use super::{HitRecord, SurfaceGeometry};
-use crate::accel::ray_f32::{gamma_f32, round_up};
+use crate::accel::ray_f32::{gamma_f32, round_up_distance};
 use crate::accel::simd::F4;
 use crate::accel::{Accel, AccelKind, Bvh, LeafItems, LeafSize};
 use crate::math::{gamma, Bounds3, Ray, Vec3};
@@ -39,17 +39,13 @@ type Corners = [[f32; 3]; 3];
 
 #[derive(Clone, Debug)]
 pub struct TriangleMesh {
-    /// With a BVH, the triangles' corners, slot `s` in lane `s % 4` of block `s / 4`; else
-    /// empty. With `vertices`, the mesh's only copy of its positions (shading widens them
-    /// to f64, exactly).
+    /// The triangles' corners, slot `s` in lane `s % 4` of block `s / 4`, in the
+    /// structure's order: the mesh's only copy of its positions (shading widens them to
+    /// f64, exactly). A grid or an octree holds a triangle once in each of its cells.
     blocks: Vec<Block>,
-    /// With another structure, the vertex positions padded to four lanes; else empty. A
-    /// cell lists triangles from anywhere in the mesh: vertices shared by its triangles
-    /// are fetched once, where blocks would hold each triangle whole.
-    vertices: Vec<[f32; LANES]>,
     /// Per slot, the triangle's position in the list the mesh was made from, or [`PAD`].
     source: Vec<u32>,
-    /// Per slot, the triangle's vertex indices: with `vertices`, or where `keeps_indices`.
+    /// Per slot, the triangle's vertex indices where `keeps_indices`; else empty.
     indices: Vec<[u32; 3]>,
     /// The vertex indices the mesh was made with are kept (for normals, uvs, or the caller).
     keeps_indices: bool,
@@ -177,7 +173,6 @@ impl TriangleMesh {
             .collect();
         let mut mesh = TriangleMesh {
             blocks: Vec::new(),
-            vertices: Vec::new(),
             source: Vec::new(),
             indices: Vec::new(),
             keeps_indices: keep_indices,
@@ -199,7 +194,6 @@ impl TriangleMesh {
         let (corners, indices) = self.in_source_order();
         let mut mesh = TriangleMesh {
             blocks: Vec::new(),
-            vertices: Vec::new(),
             source: Vec::new(),
             indices: Vec::new(),
             normals: self.normals.clone(),
@@ -219,8 +213,8 @@ impl TriangleMesh {
     }
 
     /// Builds a `kind` structure over triangles given in the order the mesh was made from
-    /// (with their vertex indices, or none), and stores them in its order: in blocks, a
-    /// BVH's leaves padded to whole blocks; else indexed, in Morton order.
+    /// (with their vertex indices, or none), and stores them in blocks in its order: every
+    /// BVH leaf, grid cell or octree leaf a run of whole blocks.
     fn store(&mut self, corners: &[Corners], indices: &[[u32; 3]], kind: AccelKind) {
         let bounds: Vec<Bounds3> = corners
             .iter()
@@ -229,47 +223,33 @@ impl TriangleMesh {
                 Bounds3::from_points(widened)
             })
             .collect();
-        if kind != AccelKind::Bvh {
-            // The triangles of a cell then lie near each other in memory.
-            let order = morton_order(&bounds);
-            let sorted: Vec<Bounds3> = order.iter().map(|&s| bounds[s as usize]).collect();
-            // Vertices numbered in this order too, unless the mesh keeps its numbering.
-            let sorted_corners: Vec<Corners> = order.iter().map(|&s| corners[s as usize]).collect();
-            let sorted_indices: Vec<[u32; 3]> = match indices.is_empty() {
-                true => Vec::new(),
-                false => order.iter().map(|&s| indices[s as usize]).collect(),
-            };
-            let (vertices, triangles) =
-                index_corners(&sorted_corners, &sorted_indices, self.vertex_count);
-            self.accel = Accel::build(kind, &sorted, LEAF);
-            self.blocks = Vec::new();
-            self.vertices = vertices.iter().map(|&[x, y, z]| [x, y, z, 0.0]).collect();
-            self.indices = triangles;
-            self.source = order;
-            return;
-        }
-        let mut bvh = Bvh::build(&bounds, LEAF.max_leaf, LEAF.block);
-        let mut order = bvh.take_padded_order(LANES);
-        // Every triangle has a box, so every one is in the order; but keep any left out,
-        // after the leaves.
-        let mut listed = vec![false; corners.len()];
-        order
-            .iter()
-            .filter(|&&s| s != PAD)
-            .for_each(|&s| listed[s as usize] = true);
-        order.extend((0..corners.len() as u32).filter(|&s| !listed[s as usize]));
+        let mut accel = Accel::build(kind, &bounds, LEAF);
+        let mut order = match &mut accel {
+            Accel::Bvh(bvh) => {
+                let mut order = bvh.take_padded_order(LANES);
+                // Every triangle has a box, so every one is in the order; but keep any left
+                // out, after the leaves.
+                let mut listed = vec![false; corners.len()];
+                order
+                    .iter()
+                    .filter(|&&s| s != PAD)
+                    .for_each(|&s| listed[s as usize] = true);
+                order.extend((0..corners.len() as u32).filter(|&s| !listed[s as usize]));
+                order
+            }
+            Accel::Grid(grid) => grid.take_padded_runs(LANES, PAD),
+            Accel::Octree(octree) => octree.take_padded_runs(LANES, PAD),
+            // Brute force names the triangles one by one, as given.
+            Accel::None(_) => (0..corners.len() as u32).collect(),
+        };
         order.resize(order.len().next_multiple_of(LANES), PAD);
-        self.accel = Accel::Bvh(bvh);
-        self.vertices = Vec::new();
         self.blocks = order
             .chunks(LANES)
             .map(|slots| {
-                // A padding lane repeats a triangle of its block: every lane holds numbers.
-                let filler = slots.iter().copied().find(|&s| s != PAD).unwrap_or(0);
-                let mut block = Block([[[0.0; LANES]; 3]; 3]);
-                for (lane, &s) in slots.iter().enumerate() {
-                    let c = &corners[if s == PAD { filler } else { s } as usize];
-                    for (k, corner) in c.iter().enumerate() {
+                // A padding lane's corners are NaN: every comparison fails, so no ray hits it.
+                let mut block = Block([[[f32::NAN; LANES]; 3]; 3]);
+                for (lane, &s) in slots.iter().enumerate().filter(|(_, &s)| s != PAD) {
+                    for (k, corner) in corners[s as usize].iter().enumerate() {
                         for (a, &v) in corner.iter().enumerate() {
                             block.0[k][a][lane] = v;
                         }
@@ -291,6 +271,7 @@ impl TriangleMesh {
             Vec::new()
         };
         self.source = order;
+        self.accel = accel;
     }
 
     /// The triangles' corners, and the vertex indices the mesh was made with where it keeps
@@ -318,7 +299,6 @@ impl TriangleMesh {
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of::<TriangleMesh>()
             + self.blocks.len() * std::mem::size_of::<Block>()
-            + self.vertices.len() * std::mem::size_of::<[f32; LANES]>()
             + self.source.len() * std::mem::size_of::<u32>()
             + self.indices.len() * std::mem::size_of::<[u32; 3]>()
             + self.normals.len() * std::mem::size_of::<Vec3>()
@@ -348,11 +328,16 @@ impl TriangleMesh {
         &self.uvs
     }
 
-    /// The stored triangles, each as the part hits name it by ([`HitRecord::part`]) and its
-    /// corners.
+    /// The stored triangles, each once, as a part hits name it by ([`HitRecord::part`]) and
+    /// its corners.
     pub fn triangles(&self) -> impl Iterator<Item = (u32, [Vec3; 3])> + '_ {
+        // A grid or an octree stores a triangle in each of its cells: the first stands.
+        let mut seen = vec![false; self.triangle_count];
         (0..self.source.len() as u32)
-            .filter(|&part| self.source[part as usize] != PAD)
+            .filter(move |&part| {
+                let s = self.source[part as usize];
+                s != PAD && !std::mem::replace(&mut seen[s as usize], true)
+            })
             .map(|part| (part, self.triangle(part)))
     }
 
@@ -363,12 +348,6 @@ impl TriangleMesh {
     }
 
     fn corners_f32(&self, part: u32) -> Corners {
-        if self.blocks.is_empty() {
-            return self.indices[part as usize].map(|v| {
-                let [x, y, z, _] = self.vertices[v as usize];
-                [x, y, z]
-            });
-        }
         let (block, lane) = (part as usize / LANES, part as usize % LANES);
         let b = &self.blocks[block].0;
         [0, 1, 2].map(|k| [0, 1, 2].map(|a| b[k][a][lane]))
@@ -405,9 +384,9 @@ impl TriangleMesh {
         // Prepared at the first leaf: most rays that miss never reach one.
         let mut sheared = None;
         let mut best = None;
-        self.visit_blocks::<true>(ray, t_max, |block, parts, count, t_max| {
+        self.visit_blocks::<true>(ray, t_max, |block, base, lanes, t_max| {
             let r = sheared.get_or_insert_with(|| ShearedRay::new(ray));
-            if let Some(hit) = self.intersect_block(r, ray, block, parts, count, *t_max) {
+            if let Some(hit) = self.intersect_block(r, ray, block, base, lanes, *t_max) {
                 *t_max = hit.t;
                 best = Some(hit);
             }
@@ -420,94 +399,88 @@ impl TriangleMesh {
     pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
         let mut sheared = None;
         let mut found = None;
-        self.visit_blocks::<false>(ray, t_max, |block, parts, count, t_max| {
+        self.visit_blocks::<false>(ray, t_max, |block, base, lanes, t_max| {
             let r = sheared.get_or_insert_with(|| ShearedRay::new(ray));
-            found = self.intersect_block(r, ray, block, parts, count, *t_max);
+            found = self.intersect_block(r, ray, block, base, lanes, *t_max);
             found.is_none()
         });
         found
     }
 
-    /// Hands `test(block, parts, count, t_max)` blocks of up to four triangles the ray may
-    /// meet, roughly nearest first if `NEAREST_FIRST`, until it returns false. Lanes from
-    /// `count` on are to be ignored.
+    /// Hands `test(block, base, lanes, t_max)` blocks of up to four triangles the ray may
+    /// meet (slots `base..base + 4`, the lanes set in `lanes` to be tested), roughly
+    /// nearest first if `NEAREST_FIRST`, until it returns false.
     #[inline(always)]
     fn visit_blocks<const NEAREST_FIRST: bool>(
         &self,
         ray: &Ray,
         t_max: f64,
-        mut test: impl FnMut(&Block, [u32; LANES], usize, &mut f64) -> bool,
+        mut test: impl FnMut(&Block, u32, u32, &mut f64) -> bool,
     ) {
-        if let Accel::Bvh(bvh) = &self.accel {
-            // A leaf is a run of slots starting a block: its blocks are read in place.
-            let visit_run = |run: Range<usize>, t_max: &mut f64| {
-                for base in run.clone().step_by(LANES) {
-                    debug_assert!(base % LANES == 0 && base / LANES < self.blocks.len());
-                    // SAFETY: the BVH's runs lie within the slots it ordered, all stored.
-                    let block = unsafe { self.blocks.get_unchecked(base / LANES) };
-                    let parts = [0, 1, 2, 3].map(|lane| (base + lane) as u32);
-                    if !test(block, parts, (run.end - base).min(LANES), t_max) {
-                        return false;
-                    }
-                }
-                true
-            };
-            let items = LeafItems::packed(&self.blocks, LANES);
-            if NEAREST_FIRST {
-                bvh.traverse_runs(ray, t_max, items, visit_run);
-            } else {
-                bvh.traverse_runs_any_order(ray, t_max, items, visit_run);
-            }
-            return;
-        }
-        // A triangle met again in another cell is simply tested again: no stamps needed.
-        self.accel.traverse_repeating(ray, t_max, |items, t_max| {
-            for chunk in items.chunks(LANES) {
-                let last = chunk.len() - 1;
-                let parts = [0, 1, 2, 3].map(|lane| chunk[lane.min(last)]);
-                // Gathered into a block on the stack: the test then reads every block alike.
-                if !test(&self.gather(parts), parts, chunk.len(), t_max) {
-                    return false;
+        let mut visit_run =
+            |run: Range<usize>, t_max: &mut f64| self.visit_run(run, t_max, &mut test);
+        match &self.accel {
+            Accel::Bvh(bvh) => {
+                let items = LeafItems::packed(&self.blocks, LANES);
+                if NEAREST_FIRST {
+                    bvh.traverse_runs(ray, t_max, items, visit_run);
+                } else {
+                    bvh.traverse_runs_any_order(ray, t_max, items, visit_run);
                 }
             }
-            true
-        });
-    }
-
-    /// A block of four triangles from anywhere in an indexed mesh.
-    #[inline(always)]
-    fn gather(&self, parts: [u32; LANES]) -> Block {
-        debug_assert!(parts.iter().all(|&p| (p as usize) < self.indices.len()));
-        // SAFETY: parts come from the structure built over these triangles.
-        let tri = |lane: usize| unsafe { *self.indices.get_unchecked(parts[lane] as usize) };
-        let (t0, t1, t2, t3) = (tri(0), tri(1), tri(2), tri(3));
-        let mut block = Block([[[0.0; LANES]; 3]; 3]);
-        for k in 0..3 {
-            // SAFETY: every index was checked against the vertex count in `new`.
-            let p = |t: [u32; 3]| F4::load(unsafe { self.vertices.get_unchecked(t[k] as usize) });
-            let [x, y, z, _] = F4::transpose([p(t0), p(t1), p(t2), p(t3)]);
-            block.0[k] = [x.to_array(), y.to_array(), z.to_array()];
+            Accel::Grid(grid) => grid.traverse_runs(ray, t_max, visit_run),
+            Accel::Octree(octree) => octree.traverse_runs(ray, t_max, visit_run),
+            Accel::None(brute) => brute.traverse(ray, t_max, |items, t_max| {
+                items
+                    .iter()
+                    .all(|&slot| visit_run(slot as usize..slot as usize + 1, t_max))
+            }),
         }
-        block
     }
 
-    /// The nearest hit among up to four triangles, tested together; lanes from `count` on
-    /// are ignored.
+    /// Hands `test` the blocks of a run of slots, read in place, until it returns false.
+    /// Lanes outside the run are left out; padding lanes inside it miss (NaN corners). Kept
+    /// out of the traversal loop with the test: inlined there, they leave the loop too few
+    /// registers.
+    #[inline(never)]
+    fn visit_run(
+        &self,
+        run: Range<usize>,
+        t_max: &mut f64,
+        test: &mut impl FnMut(&Block, u32, u32, &mut f64) -> bool,
+    ) -> bool {
+        // A structure's runs start a block; brute force's single slots need not.
+        let skip = run.start % LANES;
+        let mut from = !0u32 << skip;
+        for base in (run.start - skip..run.end).step_by(LANES) {
+            debug_assert!(base / LANES < self.blocks.len());
+            // SAFETY: the structure's runs lie within the slots it ordered, all stored.
+            let block = unsafe { self.blocks.get_unchecked(base / LANES) };
+            let lanes = from & ((1 << (run.end - base).min(LANES)) - 1);
+            from = !0;
+            if !test(block, base as u32, lanes, t_max) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// The nearest hit among the lanes set in `lanes` of a block, tested together.
     #[inline(always)]
     fn intersect_block(
         &self,
         r: &ShearedRay,
         ray: &Ray,
         block: &Block,
-        parts: [u32; LANES],
-        count: usize,
+        base: u32,
+        lanes: u32,
         t_max: f64,
     ) -> Option<HitRecord> {
         // One copy of the test per axis the ray runs along, so the permutation is static.
         match r.axes[2] {
-            0 => self.intersect_block_along::<0>(r, ray, block, parts, count, t_max),
-            1 => self.intersect_block_along::<1>(r, ray, block, parts, count, t_max),
-            _ => self.intersect_block_along::<2>(r, ray, block, parts, count, t_max),
+            0 => self.intersect_block_along::<0>(r, ray, block, base, lanes, t_max),
+            1 => self.intersect_block_along::<1>(r, ray, block, base, lanes, t_max),
+            _ => self.intersect_block_along::<2>(r, ray, block, base, lanes, t_max),
         }
     }
 
@@ -517,8 +490,8 @@ impl TriangleMesh {
         r: &ShearedRay,
         ray: &Ray,
         block: &Block,
-        parts: [u32; LANES],
-        count: usize,
+        base: u32,
+        lanes: u32,
         t_max: f64,
     ) -> Option<HitRecord> {
         let (kx, ky) = ((KZ + 1) % 3, (KZ + 2) % 3);
@@ -531,14 +504,14 @@ impl TriangleMesh {
             [x.add(r.shear[0].mul(z)), y.add(r.shear[1].mul(z)), z]
         };
         let (a, b, c) = (corner(0), corner(1), corner(2));
-        let lanes = (1u32 << count) - 1;
         let e0 = b[0].mul(c[1]).sub(b[1].mul(c[0]));
         let e1 = c[0].mul(a[1]).sub(c[1].mul(a[0]));
         let e2 = a[0].mul(b[1]).sub(a[1].mul(b[0]));
         let zero = F4::splat(0.0);
-        let negative = e0.lt(zero) | e1.lt(zero) | e2.lt(zero);
-        let positive = zero.lt(e0) | zero.lt(e1) | zero.lt(e2);
-        let mut inside = !(negative & positive) & lanes;
+        // All three of one sign; a NaN (padding) lane is neither.
+        let non_negative = zero.le(e0) & zero.le(e1) & zero.le(e2);
+        let non_positive = e0.le(zero) & e1.le(zero) & e2.le(zero);
+        let mut inside = (non_negative | non_positive) & lanes;
         if inside == 0 {
             return None;
         }
@@ -550,7 +523,7 @@ impl TriangleMesh {
         let (az, bz, cz) = (a[2].mul(sz), b[2].mul(sz), c[2].mul(sz));
         let t_scaled = e0.mul(az).add(e1.mul(bz)).add(e2.mul(cz));
         let t = t_scaled.div(det);
-        let limit = F4::splat(round_up(t_max));
+        let limit = F4::splat(round_up_distance(t_max));
         inside &= zero.lt(t) & t.lt(limit) & !det.eq(zero);
         let mut best: Option<HitRecord> = None;
         if inside != 0 {
@@ -586,7 +559,7 @@ impl TriangleMesh {
                         t: t[lane] as f64,
                         u: (e1[lane] / det[lane]) as f64,
                         v: (e2[lane] / det[lane]) as f64,
-                        part: parts[lane],
+                        part: base + lane as u32,
                     });
                 }
             }
@@ -596,12 +569,14 @@ impl TriangleMesh {
             let lane = on_edge.trailing_zeros() as usize;
             on_edge &= on_edge - 1;
             let limit = best.map_or(t_max, |h| h.t);
-            if let Some((t, b1, b2)) = intersect_triangle(ray, limit, self.triangle(parts[lane])) {
+            if let Some((t, b1, b2)) =
+                intersect_triangle(ray, limit, self.triangle(base + lane as u32))
+            {
                 best = Some(HitRecord {
                     t,
                     u: b1,
                     v: b2,
-                    part: parts[lane],
+                    part: base + lane as u32,
                 });
             }
         }
@@ -712,36 +687,6 @@ fn index_corners(
         })
         .collect();
     (vertices, triangles)
-}
-
-/// The items sorted by the Morton code of their boxes' centres (Z-order, ten bits per axis):
-/// items near each other in space come near each other in the list.
-fn morton_order(bounds: &[Bounds3]) -> Vec<u32> {
-    let all = bounds.iter().fold(Bounds3::default(), |b, i| b.union(i));
-    let extent = all.max - all.min;
-    // Bits 0, 3, 6, … of the result are those of `v`.
-    let spread = |v: u32| {
-        let mut x = v & 0x3FF;
-        x = (x | (x << 16)) & 0x0300_00FF;
-        x = (x | (x << 8)) & 0x0300_F00F;
-        x = (x | (x << 4)) & 0x030C_30C3;
-        (x | (x << 2)) & 0x0924_9249
-    };
-    let code = |b: &Bounds3| {
-        let c = (b.min + b.max) * 0.5 - all.min;
-        let cell = |a: usize| {
-            let f = if extent[a] > 0.0 {
-                c[a] / extent[a]
-            } else {
-                0.0
-            };
-            (f * 1023.0).clamp(0.0, 1023.0) as u32
-        };
-        spread(cell(0)) | (spread(cell(1)) << 1) | (spread(cell(2)) << 2)
-    };
-    let mut order: Vec<u32> = (0..bounds.len() as u32).collect();
-    order.sort_by_cached_key(|&i| code(&bounds[i as usize]));
-    order
 }
 
 /// Whether every edge is shared by exactly two triangles. Vertices are matched by position,
