@@ -13,8 +13,11 @@ use super::{append_padded, nearest, split_off_large};
 use crate::math::{Bounds3, Ray, Vec3};
 use std::ops::Range;
 
-/// Cells per item.
+/// Cells per item, for items tested one by one (a scene's primitives).
 const LAMBDA: f64 = 1.5;
+/// Cells per item, for items tested four at a time (a mesh's triangles, in blocks), whose
+/// tests cost less per item: 5–11 % faster than [`LAMBDA`] on the dragon's rays.
+const LAMBDA_BLOCKS: f64 = 0.75;
 const MAX_RESOLUTION: usize = 512;
 /// Cells per macro cell along each axis (a power of two).
 const MACRO: usize = 4;
@@ -44,7 +47,10 @@ pub struct Grid {
 }
 
 impl Grid {
-    pub fn build(item_bounds: &[Bounds3]) -> Grid {
+    /// A grid over items given by their bounds, for a caller that tests `block` items at a
+    /// time.
+    pub fn build(item_bounds: &[Bounds3], block: usize) -> Grid {
+        let lambda = if block > 1 { LAMBDA_BLOCKS } else { LAMBDA };
         let (bounded, large) = split_off_large(item_bounds);
         let union = |items: &[u32]| {
             items.iter().fold(Bounds3::default(), |b, &i| {
@@ -80,7 +86,7 @@ impl Grid {
             extent.y.max(floor),
             extent.z.max(floor),
         );
-        let per_unit = (LAMBDA * bounded.len() as f64 / (thick.x * thick.y * thick.z)).cbrt();
+        let per_unit = (lambda * bounded.len() as f64 / (thick.x * thick.y * thick.z)).cbrt();
         for a in 0..3 {
             let cells = (extent[a] * per_unit).round() as usize;
             grid.resolution[a] = cells.clamp(1, MAX_RESOLUTION);

@@ -133,8 +133,8 @@ impl Accel {
     pub fn build(kind: AccelKind, item_bounds: &[Bounds3], leaf: LeafSize) -> Accel {
         match kind {
             AccelKind::Bvh => Accel::Bvh(Bvh::build(item_bounds, leaf.max_leaf, leaf.block)),
-            AccelKind::Grid => Accel::Grid(Grid::build(item_bounds)),
-            AccelKind::Octree => Accel::Octree(Octree::build(item_bounds)),
+            AccelKind::Grid => Accel::Grid(Grid::build(item_bounds, leaf.block)),
+            AccelKind::Octree => Accel::Octree(Octree::build(item_bounds, leaf.block)),
             AccelKind::None => Accel::None(BruteForce::build(item_bounds)),
         }
     }

@@ -11,10 +11,29 @@ use crate::math::{Bounds3, Ray, Vec3};
 use std::mem::MaybeUninit;
 use std::ops::Range;
 
-const LEAF_ITEMS: usize = 8;
 const MAX_DEPTH: usize = 16;
-/// Visiting a cell's children, in item tests.
-const SPLIT_COST: usize = 8;
+
+/// When a cell is split: it holds more than `leaf_items`, and splitting saves more than
+/// `split_cost` item tests (the cost of visiting the children).
+#[derive(Clone, Copy)]
+struct Splitting {
+    leaf_items: usize,
+    split_cost: usize,
+}
+
+/// For items tested one by one (a scene's primitives).
+const ONE_BY_ONE: Splitting = Splitting {
+    leaf_items: 8,
+    split_cost: 8,
+};
+
+/// For items tested four at a time (a mesh's triangles, in blocks), whose tests cost less
+/// per item: 10–18 % faster than [`ONE_BY_ONE`] on the bunny's, the dragon's and the
+/// icosphere's rays (docs/acceleration.md).
+const IN_BLOCKS: Splitting = Splitting {
+    leaf_items: 16,
+    split_cost: 20,
+};
 /// A ray passes through at most four of a cell's children.
 const STACK: usize = 3 * MAX_DEPTH + 2;
 
@@ -80,7 +99,10 @@ fn child_box(lo: Vec3, hi: Vec3, octant: usize) -> (Vec3, Vec3) {
 }
 
 impl Octree {
-    pub fn build(item_bounds: &[Bounds3]) -> Octree {
+    /// An octree over items given by their bounds, for a caller that tests `block` items
+    /// at a time.
+    pub fn build(item_bounds: &[Bounds3], block: usize) -> Octree {
+        let splitting = if block > 1 { IN_BLOCKS } else { ONE_BY_ONE };
         let (bounded, large) = split_off_large(item_bounds);
         let union = |items: &[u32]| {
             items.iter().fold(Bounds3::default(), |b, &i| {
@@ -106,7 +128,8 @@ impl Octree {
         let margin = bounds.diagonal().max_component() * 1e-9;
         let filed: Vec<Bounds3> = item_bounds.iter().map(|b| b.expanded(margin)).collect();
         tree.bounds = bounds.expanded(margin);
-        tree.build_node(0, tree.bounds.min, tree.bounds.max, bounded, 0, &filed);
+        let (lo, hi) = (tree.bounds.min, tree.bounds.max);
+        tree.build_node(0, lo, hi, bounded, 0, &filed, splitting);
         tree.has_items = !tree.items.is_empty();
         tree
     }
@@ -119,6 +142,7 @@ impl Octree {
         items: Vec<u32>,
         depth: usize,
         filed: &[Bounds3],
+        splitting: Splitting,
     ) {
         let make_leaf = |tree: &mut Octree, items: &[u32]| {
             *tree.node_mut(node) = OctNode {
@@ -127,7 +151,7 @@ impl Octree {
             };
             tree.items.extend_from_slice(items);
         };
-        if items.len() <= LEAF_ITEMS || depth >= MAX_DEPTH {
+        if items.len() <= splitting.leaf_items || depth >= MAX_DEPTH {
             return make_leaf(self, &items);
         }
         let mid = (lo + hi) * 0.5;
@@ -152,7 +176,7 @@ impl Octree {
         // pays for visiting the children. Items that mostly straddle the centre make the
         // split cost more than it saves.
         let copies: usize = children.iter().map(Vec::len).sum();
-        if copies + 4 * SPLIT_COST >= 4 * items.len() {
+        if copies + 4 * splitting.split_cost >= 4 * items.len() {
             return make_leaf(self, &items);
         }
         let block = self.blocks.len();
@@ -162,7 +186,15 @@ impl Octree {
         for (octant, list) in children.into_iter().enumerate() {
             occupied |= u32::from(!list.is_empty()) << octant;
             let (clo, chi) = child_box(lo, hi, octant);
-            self.build_node(block * 8 + octant, clo, chi, list, depth + 1, filed);
+            self.build_node(
+                block * 8 + octant,
+                clo,
+                chi,
+                list,
+                depth + 1,
+                filed,
+                splitting,
+            );
         }
         *self.node_mut(node) = OctNode {
             first: block as u32,
