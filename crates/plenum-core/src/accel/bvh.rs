@@ -392,7 +392,9 @@ impl Bvh {
     }
 
     /// [`Bvh::traverse_runs`] for a caller that stops at any hit, such as a shadow ray: the
-    /// leaves come in no particular order, which spares sorting the children of each node.
+    /// leaves come in no particular order, which spares sorting the children of each node,
+    /// and `visit` must not lower `t_max` (it stops instead), which spares comparing each
+    /// waiting child's distance with it.
     #[inline]
     pub fn traverse_runs_any_order(
         &self,
@@ -488,7 +490,8 @@ impl Bvh {
                         continue;
                     }
                     if !NEAREST_FIRST {
-                        // Any order will do (as for shadow rays): no distances compared.
+                        // Any order will do (as for shadow rays): no distances kept, since
+                        // `t_max` never falls below one of a child already found to cross.
                         current = node.children[first];
                         while hits != 0 {
                             let i = hits.trailing_zeros() as usize & 7;
@@ -496,11 +499,7 @@ impl Bvh {
                             self.prefetch(node.children[i], items);
                             debug_assert!(top < STACK);
                             // SAFETY: `top` stays below STACK (see there).
-                            unsafe {
-                                stack
-                                    .get_unchecked_mut(top)
-                                    .write((node.children[i], near[i]))
-                            };
+                            unsafe { stack.get_unchecked_mut(top).write((node.children[i], 0.0)) };
                             top += 1;
                         }
                         continue;
@@ -544,7 +543,7 @@ impl Bvh {
                 top -= 1;
                 // SAFETY: entries below `top` were written when pushed.
                 let (next, near) = unsafe { stack.get_unchecked(top).assume_init() };
-                if near <= limit {
+                if !NEAREST_FIRST || near <= limit {
                     current = next;
                     break;
                 }
