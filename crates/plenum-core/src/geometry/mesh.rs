@@ -508,10 +508,11 @@ impl TriangleMesh {
         let e1 = c[0].mul(a[1]).sub(c[1].mul(a[0]));
         let e2 = a[0].mul(b[1]).sub(a[1].mul(b[0]));
         let zero = F4::splat(0.0);
-        // All three of one sign; a NaN (padding) lane is neither.
-        let non_negative = zero.le(e0) & zero.le(e1) & zero.le(e2);
-        let non_positive = e0.le(zero) & e1.le(zero) & e2.le(zero);
-        let mut inside = (non_negative | non_positive) & lanes;
+        // All three of one sign: the least not below zero, or the greatest not above. A
+        // padding lane's NaNs pass neither comparison.
+        let least = e0.min(e1).min(e2);
+        let greatest = e0.max(e1).max(e2);
+        let mut inside = (zero.le(least) | greatest.le(zero)) & lanes;
         if inside == 0 {
             return None;
         }
