@@ -881,6 +881,46 @@ mod tests {
     }
 
     #[test]
+    fn large_triangles_kept_out_of_cells_are_still_hit() {
+        // A small sheet above a ground of two triangles forty times as wide: the grid and
+        // the octree test the ground on every ray, from the first run of their slots.
+        let (mut positions, mut triangles) = sheet(8);
+        let n = positions.len() as u32;
+        positions.extend([
+            Vec3::new(-160.0, -160.0, -4.0),
+            Vec3::new(160.0, -160.0, -4.0),
+            Vec3::new(160.0, 160.0, -4.0),
+            Vec3::new(-160.0, 160.0, -4.0),
+        ]);
+        triangles.extend([[n, n + 1, n + 2], [n, n + 2, n + 3]]);
+        let mesh = TriangleMesh::new(positions, triangles, vec![], vec![]).unwrap();
+        let oracle = mesh.with_accel(AccelKind::None);
+        for kind in [AccelKind::Bvh, AccelKind::Grid, AccelKind::Octree] {
+            let m = mesh.with_accel(kind);
+            let mut ground = 0;
+            for i in 0..400 {
+                let (x, y) = ((i % 20) as f64 * 1.7 - 12.0, (i / 20) as f64 * 1.7 - 12.0);
+                let ray = Ray::new(Vec3::new(x, y, 10.0), Vec3::new(0.01, 0.02, -1.0));
+                let name = |m: &TriangleMesh, h: Option<HitRecord>| {
+                    h.map(|h| (m.source_triangle(h.part), h.t))
+                };
+                let want = name(&oracle, oracle.intersect(&ray, f64::INFINITY));
+                assert_eq!(
+                    name(&m, m.intersect(&ray, f64::INFINITY)),
+                    want,
+                    "{kind}: {i}"
+                );
+                assert_eq!(
+                    m.intersect_any(&ray, f64::INFINITY).is_some(),
+                    want.is_some()
+                );
+                ground += usize::from(want.is_some_and(|(source, _)| source >= 128));
+            }
+            assert!(ground > 200, "{kind}: {ground} rays reach the ground");
+        }
+    }
+
+    #[test]
     fn a_bvh_mesh_takes_at_most_64_bytes_a_triangle() {
         // The budget of the acceleration issue, vertices, indices and nodes included.
         let (positions, triangles) = sheet(100);
