@@ -357,6 +357,72 @@ indices = [[0, 1, 2]]
     );
 }
 
+/// Per-vertex materials follow the vertices they were given to on a mesh its BVH reorders:
+/// a strip whose left half's vertices glow red and right half's green, the vertices listed
+/// out of order, shows pure red on the left and pure green on the right. (Until 2026-12 the
+/// BVH renumbered a mesh's vertices, and the materials landed on the wrong ones.)
+#[test]
+fn vertex_materials_stay_with_their_vertices() {
+    let columns = 33;
+    // Vertex (i, j) is listed at `id`: the columns interleaved, odd ones first.
+    let id = |i: usize, j: usize| {
+        let slot = if i % 2 == 1 {
+            i / 2
+        } else {
+            columns / 2 + i / 2
+        };
+        2 * slot + j
+    };
+    let mut positions = vec![String::new(); 2 * columns];
+    let mut materials = vec![""; 2 * columns];
+    for i in 0..columns {
+        let x = -8.0 + 16.0 * i as f64 / (columns - 1) as f64;
+        for j in 0..2 {
+            positions[id(i, j)] = format!("[{x}, {}, 0]", 2.0 * j as f64 - 1.0);
+            materials[id(i, j)] = if x < 0.0 { "\"r\"" } else { "\"g\"" };
+        }
+    }
+    let indices: Vec<String> = (0..columns - 1)
+        .flat_map(|i| {
+            let (a, b, c, d) = (id(i, 0), id(i + 1, 0), id(i + 1, 1), id(i, 1));
+            [format!("[{a}, {b}, {c}]"), format!("[{a}, {c}, {d}]")]
+        })
+        .collect();
+    let text = format!(
+        r#"
+[camera]
+position = [0, 0, 20]
+look_at = [0, 0, 0]
+fov = 6
+resolution = [16, 3]
+[materials.r]
+diffuse = 0
+emissive = [1, 0, 0]
+[materials.g]
+diffuse = 0
+emissive = [0, 1, 0]
+[[objects]]
+type = "mesh"
+positions = [{}]
+indices = [{}]
+vertex_materials = [{}]
+"#,
+        positions.join(", "),
+        indices.join(", "),
+        materials.join(", ")
+    );
+    let loaded = parse_scene(Path::new("strip.toml"), &text, Path::new("."))
+        .unwrap_or_else(|e| panic!("{e}"));
+    for x in (0..5).chain(11..16) {
+        let (_, c) = trace_pixel(&loaded.scene, &settings(&loaded), x, 1);
+        let (want_r, want_g) = if x < 8 { (1.0, 0.0) } else { (0.0, 1.0) };
+        assert!(
+            (c.r - want_r).abs() < 1e-6 && (c.g - want_g).abs() < 1e-6 && c.b == 0.0,
+            "pixel {x}: {c:?}"
+        );
+    }
+}
+
 /// Per-vertex materials blend across a triangle by barycentric weight: at the centroid of a
 /// triangle whose corners glow red, green and blue, the colour is one third of each.
 #[test]
