@@ -15,6 +15,7 @@
 //! and the ray origin is rounded up or down per plane so that the f32 origin never moves a
 //! box out of the ray's way.
 
+use super::append_padded;
 #[cfg(target_arch = "x86_64")]
 use super::ray_f32::BoxRayAvx;
 use super::ray_f32::{round_down, round_up, round_up_distance, BoxRay};
@@ -213,9 +214,6 @@ impl BuildNode {
 }
 
 impl Bvh {
-    /// What pads a leaf's run to whole blocks in [`Bvh::take_padded_order`].
-    pub const PAD: u32 = u32::MAX;
-
     /// Builds over items given by their bounds, with at most `max_leaf` items per leaf, for a
     /// caller that tests `block` items at a time; the leaves refer to items by position.
     /// Empty boxes are left out.
@@ -343,7 +341,7 @@ impl Bvh {
         });
     }
 
-    /// Hands the caller the items in leaf order, each leaf padded with [`Bvh::PAD`] entries to a
+    /// Hands the caller the items in leaf order, each leaf padded with [`super::PAD`] entries to a
     /// whole number of `block`s, and leaves the BVH without them: for a caller that stores
     /// its items in this order, so that leaves name runs of them directly
     /// ([`Bvh::traverse_runs`]), no index is read per item, and every leaf starts a block.
@@ -369,11 +367,7 @@ impl Bvh {
                 new_start <= START_MASK,
                 "too many items for a BVH leaf reference"
             );
-            padded.extend_from_slice(&order[start..start + count]);
-            padded.resize(
-                new_start as usize + count.div_ceil(block) * block,
-                Self::PAD,
-            );
+            append_padded(&mut padded, &order[start..start + count], block);
             self.nodes[n].children[slot] = LEAF_BIT | ((count as u32) << COUNT_SHIFT) | new_start;
         }
         padded
@@ -803,7 +797,7 @@ mod tests {
                     if k < count {
                         seen[item as usize] += 1;
                     } else {
-                        assert_eq!(item, Bvh::PAD);
+                        assert_eq!(item, crate::accel::PAD);
                     }
                 }
             }

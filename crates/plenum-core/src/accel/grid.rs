@@ -213,18 +213,18 @@ impl Grid {
     }
 
     /// Hands the caller the items of the large run and of every cell, each padded with
-    /// `pad` entries to a whole number of `block`s and starting a block, in place of the
+    /// [`super::PAD`] entries to a whole number of `block`s and starting a block, in place of the
     /// grid's own lists: for a caller that stores its items so, as a mesh stores its
     /// triangles in blocks. Only [`Grid::traverse_runs`] may be used afterwards.
-    pub fn take_padded_runs(&mut self, block: usize, pad: u32) -> Vec<u32> {
+    pub fn take_padded_runs(&mut self, block: usize) -> Vec<u32> {
         let mut padded = Vec::with_capacity(self.items.len() * 2);
-        append_padded(&mut padded, &self.large, block, pad);
+        append_padded(&mut padded, &self.large, block);
         self.large_run = padded.len();
         let mut starts = Vec::with_capacity(self.starts.len());
         for c in 0..self.starts.len() - 1 {
             starts.push(padded.len() as u32);
             let items = &self.items[self.starts[c] as usize..self.starts[c + 1] as usize];
-            append_padded(&mut padded, items, block, pad);
+            append_padded(&mut padded, items, block);
         }
         starts.push(padded.len() as u32);
         self.large = Vec::new();

@@ -202,10 +202,14 @@ impl Accel {
     }
 }
 
-/// Appends `items` to `list`, then `pad` entries up to a whole number of `block`s.
-fn append_padded(list: &mut Vec<u32>, items: &[u32], block: usize, pad: u32) {
+/// What pads a run of items to whole blocks in the lists the structures hand a caller that
+/// stores its items in blocks (`take_padded_order`, `take_padded_runs`).
+pub const PAD: u32 = u32::MAX;
+
+/// Appends `items` to `list`, then [`PAD`] entries up to a whole number of `block`s.
+fn append_padded(list: &mut Vec<u32>, items: &[u32], block: usize) {
     list.extend_from_slice(items);
-    list.resize(list.len().next_multiple_of(block), pad);
+    list.resize(list.len().next_multiple_of(block), PAD);
 }
 
 /// The axis of the smallest of three times, and that time (the grid's and the octree's next

@@ -21,6 +21,12 @@ struct Splitting {
     split_cost: usize,
 }
 
+/// What a build files items by: their slightly grown boxes, and when to split a cell.
+struct Filing<'a> {
+    boxes: &'a [Bounds3],
+    splitting: Splitting,
+}
+
 /// For items tested one by one (a scene's primitives).
 const ONE_BY_ONE: Splitting = Splitting {
     leaf_items: 8,
@@ -129,7 +135,11 @@ impl Octree {
         let filed: Vec<Bounds3> = item_bounds.iter().map(|b| b.expanded(margin)).collect();
         tree.bounds = bounds.expanded(margin);
         let (lo, hi) = (tree.bounds.min, tree.bounds.max);
-        tree.build_node(0, lo, hi, bounded, 0, &filed, splitting);
+        let filing = Filing {
+            boxes: &filed,
+            splitting,
+        };
+        tree.build_node(0, lo, hi, bounded, 0, &filing);
         tree.has_items = !tree.items.is_empty();
         tree
     }
@@ -141,9 +151,9 @@ impl Octree {
         hi: Vec3,
         items: Vec<u32>,
         depth: usize,
-        filed: &[Bounds3],
-        splitting: Splitting,
+        filing: &Filing,
     ) {
+        let splitting = filing.splitting;
         let make_leaf = |tree: &mut Octree, items: &[u32]| {
             *tree.node_mut(node) = OctNode {
                 first: tree.items.len() as u32,
@@ -157,7 +167,7 @@ impl Octree {
         let mid = (lo + hi) * 0.5;
         let mut children: [Vec<u32>; 8] = Default::default();
         for &i in &items {
-            let b = &filed[i as usize];
+            let b = &filing.boxes[i as usize];
             for (octant, list) in children.iter_mut().enumerate() {
                 let inside = (0..3).all(|a| {
                     if octant >> a & 1 == 1 {
@@ -186,15 +196,7 @@ impl Octree {
         for (octant, list) in children.into_iter().enumerate() {
             occupied |= u32::from(!list.is_empty()) << octant;
             let (clo, chi) = child_box(lo, hi, octant);
-            self.build_node(
-                block * 8 + octant,
-                clo,
-                chi,
-                list,
-                depth + 1,
-                filed,
-                splitting,
-            );
+            self.build_node(block * 8 + octant, clo, chi, list, depth + 1, filing);
         }
         *self.node_mut(node) = OctNode {
             first: block as u32,
@@ -252,18 +254,18 @@ impl Octree {
     }
 
     /// Hands the caller the items of the large run and of every leaf, each padded with
-    /// `pad` entries to a whole number of `block`s and starting a block, in place of the
+    /// [`super::PAD`] entries to a whole number of `block`s and starting a block, in place of the
     /// octree's own lists: for a caller that stores its items so, as a mesh stores its
     /// triangles in blocks. Only [`Octree::traverse_runs`] may be used afterwards.
-    pub fn take_padded_runs(&mut self, block: usize, pad: u32) -> Vec<u32> {
+    pub fn take_padded_runs(&mut self, block: usize) -> Vec<u32> {
         let mut padded = Vec::with_capacity(self.items.len() * 2);
-        append_padded(&mut padded, &self.large, block, pad);
+        append_padded(&mut padded, &self.large, block);
         self.large_run = padded.len();
         for siblings in &mut self.blocks {
             for node in siblings.0.iter_mut().filter(|n| n.info & LEAF != 0) {
                 let (first, count) = (node.first as usize, (node.info & !LEAF) as usize);
                 node.first = padded.len() as u32;
-                append_padded(&mut padded, &self.items[first..first + count], block, pad);
+                append_padded(&mut padded, &self.items[first..first + count], block);
             }
         }
         self.large = Vec::new();

@@ -13,7 +13,7 @@
 use super::{HitRecord, SurfaceGeometry};
 use crate::accel::ray_f32::{gamma_f32, round_up_distance};
 use crate::accel::simd::F4;
-use crate::accel::{Accel, AccelKind, Bvh, LeafItems, LeafSize};
+use crate::accel::{Accel, AccelKind, LeafItems, LeafSize, PAD};
 use crate::math::{gamma, Bounds3, Ray, Vec3};
 use std::ops::Range;
 
@@ -25,9 +25,6 @@ const LEAF: LeafSize = LeafSize {
 
 /// Triangles per block.
 const LANES: usize = 4;
-
-/// A slot that only pads a BVH leaf to whole blocks.
-const PAD: u32 = Bvh::PAD;
 
 /// Four triangles' corners in f32, `[corner][axis][lane]`: the lanes the SIMD test loads.
 #[derive(Clone, Copy, Debug)]
@@ -237,8 +234,8 @@ impl TriangleMesh {
                 order.extend((0..corners.len() as u32).filter(|&s| !listed[s as usize]));
                 order
             }
-            Accel::Grid(grid) => grid.take_padded_runs(LANES, PAD),
-            Accel::Octree(octree) => octree.take_padded_runs(LANES, PAD),
+            Accel::Grid(grid) => grid.take_padded_runs(LANES),
+            Accel::Octree(octree) => octree.take_padded_runs(LANES),
             // Brute force names the triangles one by one, as given.
             Accel::None(_) => (0..corners.len() as u32).collect(),
         };
