@@ -40,8 +40,6 @@ const IN_BLOCKS: Splitting = Splitting {
     leaf_items: 16,
     split_cost: 20,
 };
-/// A ray passes through at most four of a cell's children.
-const STACK: usize = 3 * MAX_DEPTH + 2;
 
 /// A cell: a leaf with a run of items, or a parent of eight cells.
 #[derive(Clone, Copy, Debug)]
@@ -317,90 +315,125 @@ impl Octree {
             t0[a] = (lo[a] - o) * inv;
             t1[a] = (hi[a] - o) * inv;
         }
+        // Plain comparisons: the distances are never NaN, so f64::max's NaN rules would only
+        // cost instructions.
+        let larger = |a: f64, b: f64| if a > b { a } else { b };
+        let smaller = |a: f64, b: f64| if a < b { a } else { b };
+        let enter = larger(larger(t0[0], t0[1]), t0[2]);
+        let leave = smaller(smaller(t1[0], t1[1]), t1[2]);
+        if enter > t_max || leave < 0.0 || enter > leave {
+            return;
+        }
+        // The parents the ray is passing through, innermost on top. Only parents are
+        // stacked, and a parent's next child is found from its planes when the ray leaves
+        // the one before: a leaf costs no stack traffic, and a hit that lowers `t_max`
+        // ends the walk through a parent's remaining children at once. (Working out a
+        // parent's whole way through its children when it is entered, occupied ones only,
+        // runs fewer instructions but 10 % slower on the bunny's incoherent rays.)
         // Uninitialised: only entries below `top`, all written first, are read.
-        let mut stack = [MaybeUninit::<(u32, [f64; 3], [f64; 3])>::uninit(); STACK];
-        stack[0].write((0, t0, t1));
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            // SAFETY: entries below `top` were written when pushed.
-            let (index, t0, t1) = unsafe { stack.get_unchecked(top).assume_init() };
-            // Plain comparisons: the distances are never NaN, so f64::max's NaN rules would
-            // only cost instructions.
-            let larger = |a: f64, b: f64| if a > b { a } else { b };
-            let smaller = |a: f64, b: f64| if a < b { a } else { b };
-            let enter = larger(larger(t0[0], t0[1]), t0[2]);
-            let leave = smaller(smaller(t1[0], t1[1]), t1[2]);
-            if enter > t_max || leave < 0.0 || enter > leave {
-                continue;
-            }
+        let mut stack = [MaybeUninit::<Passage>::uninit(); MAX_DEPTH + 1];
+        let mut top = 0;
+        // The cell entered: its index, planes' distances, and where the ray enters it ahead
+        // of its origin. Every cell entered is one the ray crosses before `t_max`.
+        let (mut index, mut c0, mut c1, mut start) = (0u32, t0, t1, larger(enter, 0.0));
+        loop {
             let node = self.node(index as usize);
             if node.info & LEAF != 0 {
-                let start = node.first as usize;
-                if !hand(start..start + (node.info & !LEAF) as usize, &mut t_max) {
+                let first = node.first as usize;
+                if !hand(first..first + (node.info & !LEAF) as usize, &mut t_max) {
                     return;
                 }
-                continue;
-            }
-            // The children's line is read as soon as the first of them pops: ask for it
-            // while their order is worked out.
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: prefetching is only a hint and never faults.
-            unsafe {
-                use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-                let children = self.blocks.as_ptr().wrapping_add(node.first as usize);
-                _mm_prefetch(children as *const i8, _MM_HINT_T0);
-            }
-            let mut mid = [0.0; 3];
-            for a in 0..3 {
-                mid[a] = 0.5 * (t0[a] + t1[a]);
-            }
-            // The first child the ray is in ahead of its origin: upper along each axis whose
-            // mid-plane it crossed before entering the cell, or before starting where it
-            // starts inside (children behind the origin are never pushed). Then, until it
-            // leaves the cell, the next child is across the nearest of the current child's
-            // exit planes.
-            let start = larger(enter, 0.0);
-            let mut octant = 0;
-            for a in 0..3 {
-                octant |= usize::from(mid[a] < start) << a;
-            }
-            let mut path = [0usize; 4];
-            let mut n = 0;
-            loop {
-                path[n] = octant;
-                n += 1;
-                let mut exit = [0.0; 3];
+                // Whatever is left is entered beyond this cell's exit.
+                if t_max <= smaller(smaller(c1[0], c1[1]), c1[2]) {
+                    return;
+                }
+            } else {
+                // The children's line is read as soon as one of them is entered: ask for it
+                // while the way through them is worked out.
+                #[cfg(target_arch = "x86_64")]
+                // SAFETY: prefetching is only a hint and never faults.
+                unsafe {
+                    use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+                    let children = self.blocks.as_ptr().wrapping_add(node.first as usize);
+                    _mm_prefetch(children as *const i8, _MM_HINT_T0);
+                }
+                let mut mid = [0.0; 3];
+                // The first child the ray is in: upper along each axis whose mid-plane it
+                // crosses before it starts in this cell.
+                let mut octant = 0;
                 for a in 0..3 {
-                    exit[a] = if octant >> a & 1 == 1 { t1[a] } else { mid[a] };
+                    mid[a] = 0.5 * (c0[a] + c1[a]);
+                    octant |= u32::from(mid[a] < start) << a;
                 }
-                let (a, t) = nearest(exit);
-                if octant >> a & 1 == 1 || t > t_max {
-                    break;
-                }
-                octant |= 1 << a;
+                // A parent at depth k is stacked above k others, and parents lie above
+                // MAX_DEPTH.
+                debug_assert!(top < MAX_DEPTH);
+                // SAFETY: see above.
+                unsafe {
+                    stack.get_unchecked_mut(top).write(Passage {
+                        children: node.first,
+                        occupied: node.info,
+                        octant,
+                        t0: c0,
+                        mid,
+                        t1: c1,
+                        enter: start,
+                    })
+                };
+                top += 1;
             }
-            // Farthest pushed first, so the nearest pops next.
-            for &octant in path[..n].iter().rev() {
-                if node.info >> (octant ^ flip) & 1 == 0 {
+            // The next occupied child on the way, in the innermost parent not yet left.
+            loop {
+                if top == 0 {
+                    return;
+                }
+                // SAFETY: entries below `top` were written when stacked.
+                let p = unsafe { stack.get_unchecked_mut(top - 1).assume_init_mut() };
+                // A hit since the child was found may have put it out of reach, and the
+                // parent's later children with it.
+                if p.enter > t_max {
+                    top -= 1;
                     continue;
                 }
-                let child = node.first * 8 + (octant ^ flip) as u32;
-                let (mut c0, mut c1) = (t0, t1);
+                let octant = p.octant;
+                let mut exit = [0.0; 3];
                 for a in 0..3 {
-                    if octant >> a & 1 == 1 {
-                        c0[a] = mid[a];
-                    } else {
-                        c1[a] = mid[a];
-                    }
+                    let upper = octant >> a & 1 == 1;
+                    c0[a] = if upper { p.mid[a] } else { p.t0[a] };
+                    c1[a] = if upper { p.t1[a] } else { p.mid[a] };
+                    exit[a] = c1[a];
                 }
-                // A cell pops one entry and pushes at most four, and cells nest at most
-                // MAX_DEPTH deep, so `top` stays below 3 · MAX_DEPTH + 2.
-                debug_assert!(top < STACK);
-                // SAFETY: see above.
-                unsafe { stack.get_unchecked_mut(top).write((child, c0, c1)) };
-                top += 1;
+                start = p.enter;
+                let occupied = p.occupied >> (octant ^ flip) & 1 != 0;
+                let children = p.children;
+                // Next, the child across the nearest exit plane, unless that plane is the
+                // parent's own or lies beyond `t_max`.
+                let (a, t) = nearest(exit);
+                if octant >> a & 1 == 1 || t > t_max {
+                    top -= 1;
+                } else {
+                    p.octant = octant | 1 << a;
+                    p.enter = t;
+                }
+                if occupied {
+                    index = children * 8 + (octant ^ flip);
+                    break;
+                }
             }
         }
     }
+}
+
+/// A parent cell the ray is passing through: where its children lie and which hold
+/// anything (bit k for child k), the distances to its planes (mirrored, see
+/// [`Octree::descend`]), and the next child on the way with where the ray enters it.
+#[derive(Clone, Copy)]
+struct Passage {
+    children: u32,
+    occupied: u32,
+    octant: u32,
+    t0: [f64; 3],
+    mid: [f64; 3],
+    t1: [f64; 3],
+    enter: f64,
 }
