@@ -378,48 +378,29 @@ impl TriangleMesh {
 
     /// The nearest hit in (0, t_max).
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
-        // Prepared at the first leaf: most rays that miss never reach one.
-        let mut sheared = None;
-        let mut best = None;
-        self.visit_blocks::<true>(ray, t_max, |block, base, lanes, t_max| {
-            let r = sheared.get_or_insert_with(|| ShearedRay::new(ray));
-            if let Some(hit) = self.intersect_block(r, ray, block, base, lanes, *t_max) {
-                *t_max = hit.t;
-                best = Some(hit);
-            }
-            true
-        });
-        best
+        self.search::<true>(ray, t_max)
     }
 
     /// Some hit in (0, t_max), not necessarily the nearest: stops at the first one found.
     pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
-        let mut sheared = None;
-        let mut found = None;
-        self.visit_blocks::<false>(ray, t_max, |block, base, lanes, t_max| {
-            let r = sheared.get_or_insert_with(|| ShearedRay::new(ray));
-            found = self.intersect_block(r, ray, block, base, lanes, *t_max);
-            found.is_none()
-        });
-        found
+        self.search::<false>(ray, t_max)
     }
 
-    /// Hands `test(block, base, lanes, t_max)` blocks of up to four triangles the ray may
-    /// meet (slots `base..base + 4`, the lanes set in `lanes` to be tested), roughly
-    /// nearest first if `NEAREST_FIRST`, until it returns false.
+    /// The nearest hit if `NEAREST`, else the first found: the structure hands over runs
+    /// of slots (roughly nearest first if `NEAREST`), and their blocks are tested.
     #[inline(always)]
-    fn visit_blocks<const NEAREST_FIRST: bool>(
-        &self,
-        ray: &Ray,
-        t_max: f64,
-        mut test: impl FnMut(&Block, u32, u32, &mut f64) -> bool,
-    ) {
+    fn search<const NEAREST: bool>(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
+        let mut search = Search {
+            ray,
+            sheared: None,
+            hit: None,
+        };
         let mut visit_run =
-            |run: Range<usize>, t_max: &mut f64| self.visit_run(run, t_max, &mut test);
+            |run: Range<usize>, t_max: &mut f64| self.search_run::<NEAREST>(run, t_max, &mut search);
         match &self.accel {
             Accel::Bvh(bvh) => {
                 let items = LeafItems::packed(&self.blocks, LANES);
-                if NEAREST_FIRST {
+                if NEAREST {
                     bvh.traverse_runs(ray, t_max, items, visit_run);
                 } else {
                     bvh.traverse_runs_any_order(ray, t_max, items, visit_run);
@@ -433,18 +414,39 @@ impl TriangleMesh {
                     .all(|&slot| visit_run(slot as usize..slot as usize + 1, t_max))
             }),
         }
+        search.hit
     }
 
-    /// Hands `test` the blocks of a run of slots, read in place, until it returns false.
-    /// Lanes outside the run are left out; padding lanes inside it miss (NaN corners). Kept
-    /// out of the traversal loop with the test: inlined there, they leave the loop too few
-    /// registers.
+    /// Tests the blocks of a run of slots, read in place: lowers `t_max` to each nearer hit
+    /// if `NEAREST`, else returns false at the first. Lanes outside the run are left out;
+    /// padding lanes inside it miss (NaN corners). Kept out of the traversal loop: inlined
+    /// there, it leaves the loop too few registers.
     #[inline(never)]
-    fn visit_run(
+    fn search_run<const NEAREST: bool>(
         &self,
         run: Range<usize>,
         t_max: &mut f64,
-        test: &mut impl FnMut(&Block, u32, u32, &mut f64) -> bool,
+        search: &mut Search,
+    ) -> bool {
+        // Prepared at the first leaf: most rays that miss never reach one.
+        let r = search.sheared.get_or_insert_with(|| ShearedRay::new(search.ray));
+        // One copy of the loop per axis the ray runs along, so the permutation is static.
+        let (ray, hit) = (search.ray, &mut search.hit);
+        match r.axes[2] {
+            0 => self.search_run_along::<0, NEAREST>(run, t_max, r, ray, hit),
+            1 => self.search_run_along::<1, NEAREST>(run, t_max, r, ray, hit),
+            _ => self.search_run_along::<2, NEAREST>(run, t_max, r, ray, hit),
+        }
+    }
+
+    #[inline(always)]
+    fn search_run_along<const KZ: usize, const NEAREST: bool>(
+        &self,
+        run: Range<usize>,
+        t_max: &mut f64,
+        r: &ShearedRay,
+        ray: &Ray,
+        hit: &mut Option<HitRecord>,
     ) -> bool {
         // A structure's runs start a block; brute force's single slots need not.
         let skip = run.start % LANES;
@@ -455,30 +457,17 @@ impl TriangleMesh {
             let block = unsafe { self.blocks.get_unchecked(base / LANES) };
             let lanes = from & ((1 << (run.end - base).min(LANES)) - 1);
             from = !0;
-            if !test(block, base as u32, lanes, t_max) {
-                return false;
+            if let Some(h) =
+                self.intersect_block_along::<KZ>(r, ray, block, base as u32, lanes, *t_max)
+            {
+                *hit = Some(h);
+                if !NEAREST {
+                    return false;
+                }
+                *t_max = h.t;
             }
         }
         true
-    }
-
-    /// The nearest hit among the lanes set in `lanes` of a block, tested together.
-    #[inline(always)]
-    fn intersect_block(
-        &self,
-        r: &ShearedRay,
-        ray: &Ray,
-        block: &Block,
-        base: u32,
-        lanes: u32,
-        t_max: f64,
-    ) -> Option<HitRecord> {
-        // One copy of the test per axis the ray runs along, so the permutation is static.
-        match r.axes[2] {
-            0 => self.intersect_block_along::<0>(r, ray, block, base, lanes, t_max),
-            1 => self.intersect_block_along::<1>(r, ray, block, base, lanes, t_max),
-            _ => self.intersect_block_along::<2>(r, ray, block, base, lanes, t_max),
-        }
     }
 
     #[inline(always)]
@@ -622,6 +611,14 @@ impl TriangleMesh {
             uv,
         }
     }
+}
+
+/// A ray's search through a mesh's blocks: the ray, its sheared form once a leaf is
+/// reached, and the hit so far.
+struct Search<'r> {
+    ray: &'r Ray,
+    sheared: Option<ShearedRay>,
+    hit: Option<HitRecord>,
 }
 
 /// A ray prepared for the watertight test: axes permuted so the direction's largest
