@@ -395,7 +395,7 @@ impl TriangleMesh {
             sheared: None,
             hit: None,
         };
-        let mut visit_run =
+        let visit_run =
             |run: Range<usize>, t_max: &mut f64| self.search_run::<NEAREST>(run, t_max, &mut search);
         match &self.accel {
             Accel::Bvh(bvh) => {
@@ -406,6 +406,19 @@ impl TriangleMesh {
                     bvh.traverse_runs_any_order(ray, t_max, items, visit_run);
                 }
             }
+            _ => self.search_cells::<NEAREST>(ray, t_max, &mut search),
+        }
+        search.hit
+    }
+
+    /// [`TriangleMesh::search`] through the grid, the octree or brute force: apart, so that
+    /// their walks' state does not weigh on every BVH search.
+    #[inline(never)]
+    fn search_cells<const NEAREST: bool>(&self, ray: &Ray, t_max: f64, search: &mut Search) {
+        let mut visit_run =
+            |run: Range<usize>, t_max: &mut f64| self.search_run::<NEAREST>(run, t_max, search);
+        match &self.accel {
+            Accel::Bvh(_) => unreachable!("the BVH is searched inline"),
             Accel::Grid(grid) => grid.traverse_runs(ray, t_max, visit_run),
             Accel::Octree(octree) => octree.traverse_runs(ray, t_max, visit_run),
             Accel::None(brute) => brute.traverse(ray, t_max, |items, t_max| {
@@ -414,7 +427,6 @@ impl TriangleMesh {
                     .all(|&slot| visit_run(slot as usize..slot as usize + 1, t_max))
             }),
         }
-        search.hit
     }
 
     /// Tests the blocks of a run of slots, read in place: lowers `t_max` to each nearer hit
