@@ -395,8 +395,9 @@ impl TriangleMesh {
             sheared: None,
             hit: None,
         };
-        let visit_run =
-            |run: Range<usize>, t_max: &mut f64| self.search_run::<NEAREST>(run, t_max, &mut search);
+        let visit_run = |run: Range<usize>, t_max: &mut f64| {
+            self.search_run::<NEAREST, true>(run, t_max, &mut search)
+        };
         match &self.accel {
             Accel::Bvh(bvh) => {
                 let items = LeafItems::packed(&self.blocks, LANES);
@@ -415,26 +416,30 @@ impl TriangleMesh {
     /// their walks' state does not weigh on every BVH search.
     #[inline(never)]
     fn search_cells<const NEAREST: bool>(&self, ray: &Ray, t_max: f64, search: &mut Search) {
-        let mut visit_run =
-            |run: Range<usize>, t_max: &mut f64| self.search_run::<NEAREST>(run, t_max, search);
+        let visit_run = |run: Range<usize>, t_max: &mut f64| {
+            self.search_run::<NEAREST, true>(run, t_max, search)
+        };
         match &self.accel {
             Accel::Bvh(_) => unreachable!("the BVH is searched inline"),
             Accel::Grid(grid) => grid.traverse_runs(ray, t_max, visit_run),
             Accel::Octree(octree) => octree.traverse_runs(ray, t_max, visit_run),
             Accel::None(brute) => brute.traverse(ray, t_max, |items, t_max| {
-                items
-                    .iter()
-                    .all(|&slot| visit_run(slot as usize..slot as usize + 1, t_max))
+                items.iter().all(|&slot| {
+                    let slot = slot as usize;
+                    self.search_run::<NEAREST, false>(slot..slot + 1, t_max, search)
+                })
             }),
         }
     }
 
     /// Tests the blocks of a run of slots, read in place: lowers `t_max` to each nearer hit
-    /// if `NEAREST`, else returns false at the first. Lanes outside the run are left out;
-    /// padding lanes inside it miss (NaN corners). Kept out of the traversal loop: inlined
-    /// there, it leaves the loop too few registers.
+    /// if `NEAREST`, else returns false at the first. A structure's run is `PADDED`: it
+    /// starts a block, and the lanes of its last block past its end are padding, which
+    /// misses (NaN corners). Otherwise (brute force's single slots) lanes outside the run
+    /// are left out. Kept out of the traversal loop: inlined there, it leaves the loop too
+    /// few registers.
     #[inline(never)]
-    fn search_run<const NEAREST: bool>(
+    fn search_run<const NEAREST: bool, const PADDED: bool>(
         &self,
         run: Range<usize>,
         t_max: &mut f64,
@@ -445,14 +450,14 @@ impl TriangleMesh {
         // One copy of the loop per axis the ray runs along, so the permutation is static.
         let (ray, hit) = (search.ray, &mut search.hit);
         match r.axes[2] {
-            0 => self.search_run_along::<0, NEAREST>(run, t_max, r, ray, hit),
-            1 => self.search_run_along::<1, NEAREST>(run, t_max, r, ray, hit),
-            _ => self.search_run_along::<2, NEAREST>(run, t_max, r, ray, hit),
+            0 => self.search_run_along::<0, NEAREST, PADDED>(run, t_max, r, ray, hit),
+            1 => self.search_run_along::<1, NEAREST, PADDED>(run, t_max, r, ray, hit),
+            _ => self.search_run_along::<2, NEAREST, PADDED>(run, t_max, r, ray, hit),
         }
     }
 
     #[inline(always)]
-    fn search_run_along<const KZ: usize, const NEAREST: bool>(
+    fn search_run_along<const KZ: usize, const NEAREST: bool, const PADDED: bool>(
         &self,
         run: Range<usize>,
         t_max: &mut f64,
@@ -460,14 +465,18 @@ impl TriangleMesh {
         ray: &Ray,
         hit: &mut Option<HitRecord>,
     ) -> bool {
-        // A structure's runs start a block; brute force's single slots need not.
+        debug_assert!(!PADDED || run.start % LANES == 0);
         let skip = run.start % LANES;
         let mut from = !0u32 << skip;
         for base in (run.start - skip..run.end).step_by(LANES) {
             debug_assert!(base / LANES < self.blocks.len());
             // SAFETY: the structure's runs lie within the slots it ordered, all stored.
             let block = unsafe { self.blocks.get_unchecked(base / LANES) };
-            let lanes = from & ((1 << (run.end - base).min(LANES)) - 1);
+            let lanes = if PADDED {
+                (1 << LANES) - 1
+            } else {
+                from & ((1 << (run.end - base).min(LANES)) - 1)
+            };
             from = !0;
             if let Some(h) =
                 self.intersect_block_along::<KZ>(r, ray, block, base as u32, lanes, *t_max)
