@@ -478,9 +478,10 @@ impl Bvh {
                 if hits != 0 {
                     let first = hits.trailing_zeros() as usize & 7;
                     hits &= hits - 1;
-                    if node.children[first] & LEAF_BIT != 0 {
-                        self.prefetch(node.children[first], items);
-                    }
+                    // Asked for whether a leaf (whose blocks the test reads after a call) or
+                    // a node (read next anyway): which one it is, is a coin toss to the
+                    // branch predictor.
+                    self.prefetch(node.children[first], items);
                     if hits == 0 {
                         current = node.children[first];
                         continue;
