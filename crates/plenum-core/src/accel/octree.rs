@@ -407,14 +407,13 @@ impl Octree {
                 let occupied = p.occupied >> (octant ^ flip) & 1 != 0;
                 let children = p.children;
                 // Next, the child across the nearest exit plane, unless that plane is the
-                // parent's own or lies beyond `t_max`.
+                // parent's own or lies beyond `t_max`: then the parent is left (its entry,
+                // written all the same, is dead). Without branches: which way it goes is a
+                // coin toss to the branch predictor.
                 let (a, t) = nearest(exit);
-                if octant >> a & 1 == 1 || t > t_max {
-                    top -= 1;
-                } else {
-                    p.octant = octant | 1 << a;
-                    p.enter = t;
-                }
+                p.octant = octant | 1 << a;
+                p.enter = t;
+                top -= (octant >> a & 1) as usize | usize::from(t > t_max);
                 if occupied {
                     index = children * 8 + (octant ^ flip);
                     break;
