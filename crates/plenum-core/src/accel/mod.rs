@@ -217,13 +217,10 @@ fn append_padded(list: &mut Vec<u32>, items: &[u32], block: usize) {
 /// cannot predict.
 #[inline(always)]
 fn nearest(t: [f64; 3]) -> (usize, f64) {
+    use std::hint::select_unpredictable as select;
     let y_first = t[1] < t[0];
-    let (axis, time) = if y_first { (1, t[1]) } else { (0, t[0]) };
-    if t[2] < time {
-        (2, t[2])
-    } else {
-        (axis, time)
-    }
+    let (axis, time) = select(y_first, (1, t[1]), (0, t[0]));
+    select(t[2] < time, (2, t[2]), (axis, time))
 }
 
 #[cfg(test)]
