@@ -437,3 +437,69 @@ struct Passage {
     t1: [f64; 3],
     enter: f64,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn depth(tree: &Octree, id: usize) -> usize {
+        let node = tree.node(id);
+        if node.info & LEAF != 0 {
+            return 0;
+        }
+        (0..8)
+            .map(|k| depth(tree, node.first as usize * 8 + k))
+            .max()
+            .unwrap_or(0)
+            + 1
+    }
+
+    /// The items a ray is handed, in the order handed, with `t_max` left alone.
+    fn handed(tree: &Octree, ray: &Ray, t_max: f64) -> Vec<u32> {
+        let mut items = Vec::new();
+        tree.traverse(ray, t_max, |run, _| {
+            items.extend_from_slice(run);
+            true
+        });
+        items
+    }
+
+    /// Forty tiny items at one point split the cells around it to the depth limit (each
+    /// split copies them all into one child, and 40 items pay for a split), with a few
+    /// items at the corners of a unit cube to spread the tree. Rays through the point from
+    /// every side, along the axes and diagonally, from outside and from the point itself,
+    /// are handed every one of them; a segment that ends before the point is handed none.
+    #[test]
+    fn a_cluster_splits_to_the_depth_limit_and_every_ray_through_it_finds_it() {
+        let p = Vec3::new(0.3, 0.6, 0.45);
+        let tiny = Bounds3::new(p - Vec3::splat(1e-7), p + Vec3::splat(1e-7));
+        let mut boxes = vec![tiny; 40];
+        for k in 0..8 {
+            let c = Vec3::new((k & 1) as f64, (k >> 1 & 1) as f64, (k >> 2 & 1) as f64);
+            boxes.push(Bounds3::new(c - Vec3::splat(0.01), c + Vec3::splat(0.01)));
+        }
+        let tree = Octree::build(&boxes, 1);
+        assert_eq!(depth(&tree, 0), MAX_DEPTH);
+        let mut directions = Vec::new();
+        for sign in [-1.0, 1.0] {
+            directions.push(Vec3::new(sign, 0.0, 0.0));
+            directions.push(Vec3::new(0.0, sign, 0.0));
+            directions.push(Vec3::new(0.0, 0.0, sign));
+        }
+        for k in 0..8 {
+            let s = |bit: usize| if k >> bit & 1 == 1 { 1.0 } else { -1.0 };
+            directions.push(Vec3::new(s(0) * 0.3, s(1) * 0.7, s(2)).normalized());
+        }
+        for d in directions {
+            let from_outside = Ray::new(p - d * 3.0, d);
+            for ray in [from_outside, Ray::new(p, d)] {
+                let items = handed(&tree, &ray, f64::INFINITY);
+                for i in 0..40 {
+                    assert!(items.contains(&i), "{ray:?} missed item {i}");
+                }
+            }
+            let short = handed(&tree, &from_outside, 2.9);
+            assert!(short.iter().all(|&i| i >= 40), "{d:?}: {short:?}");
+        }
+    }
+}
