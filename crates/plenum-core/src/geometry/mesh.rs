@@ -446,7 +446,9 @@ impl TriangleMesh {
         search: &mut Search,
     ) -> bool {
         // Prepared at the first leaf: most rays that miss never reach one.
-        let r = search.sheared.get_or_insert_with(|| ShearedRay::new(search.ray));
+        let r = search
+            .sheared
+            .get_or_insert_with(|| ShearedRay::new(search.ray));
         // One copy of the loop per axis the ray runs along, so the permutation is static.
         let (ray, hit) = (search.ray, &mut search.hit);
         match r.axes[2] {
