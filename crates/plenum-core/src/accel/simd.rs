@@ -1,5 +1,7 @@
 //! Four f32 lanes: SSE on x86-64 (part of the baseline, so no run-time detection), plain arrays
-//! elsewhere. Only what the node and triangle tests need.
+//! elsewhere; eight lanes with AVX on x86-64, where the CPU has it. Only what the node and
+//! triangle tests need, and the [`Lanes`] trait over both, so that one triangle test serves
+//! four lanes and eight.
 
 #[cfg(target_arch = "x86_64")]
 mod imp {
@@ -199,6 +201,189 @@ mod imp {
 
 pub use imp::F4;
 
+/// What the triangle test asks of its lanes; bit i of a mask is lane i. `Isa` is what
+/// making a vector takes: nothing for SSE, proof of AVX for eight lanes.
+pub trait Lanes: Copy {
+    type Isa: Copy;
+    type Array: Copy + std::ops::Index<usize, Output = f32>;
+    fn splat(isa: Self::Isa, v: f32) -> Self;
+    fn add(self, o: Self) -> Self;
+    fn sub(self, o: Self) -> Self;
+    fn mul(self, o: Self) -> Self;
+    fn div(self, o: Self) -> Self;
+    /// Lane-wise minimum; where a lane of `self` is NaN, the lane of `o`.
+    fn min(self, o: Self) -> Self;
+    /// Lane-wise maximum; where a lane of `self` is NaN, the lane of `o`.
+    fn max(self, o: Self) -> Self;
+    fn abs(self) -> Self;
+    fn le(self, o: Self) -> u32;
+    fn lt(self, o: Self) -> u32;
+    fn eq(self, o: Self) -> u32;
+    fn to_array(self) -> Self::Array;
+}
+
+impl Lanes for F4 {
+    type Isa = ();
+    type Array = [f32; 4];
+    #[inline(always)]
+    fn splat(_: (), v: f32) -> F4 {
+        F4::splat(v)
+    }
+    #[inline(always)]
+    fn add(self, o: F4) -> F4 {
+        F4::add(self, o)
+    }
+    #[inline(always)]
+    fn sub(self, o: F4) -> F4 {
+        F4::sub(self, o)
+    }
+    #[inline(always)]
+    fn mul(self, o: F4) -> F4 {
+        F4::mul(self, o)
+    }
+    #[inline(always)]
+    fn div(self, o: F4) -> F4 {
+        F4::div(self, o)
+    }
+    #[inline(always)]
+    fn min(self, o: F4) -> F4 {
+        F4::min(self, o)
+    }
+    #[inline(always)]
+    fn max(self, o: F4) -> F4 {
+        F4::max(self, o)
+    }
+    #[inline(always)]
+    fn abs(self) -> F4 {
+        F4::abs(self)
+    }
+    #[inline(always)]
+    fn le(self, o: F4) -> u32 {
+        F4::le(self, o)
+    }
+    #[inline(always)]
+    fn lt(self, o: F4) -> u32 {
+        F4::lt(self, o)
+    }
+    #[inline(always)]
+    fn eq(self, o: F4) -> u32 {
+        F4::eq(self, o)
+    }
+    #[inline(always)]
+    fn to_array(self) -> [f32; 4] {
+        F4::to_array(self)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use avx::{Avx, F8};
+
+/// AVX is an x86 extension: elsewhere there is no proof of it to be had.
+#[cfg(not(target_arch = "x86_64"))]
+#[derive(Clone, Copy, Debug)]
+pub enum Avx {}
+
+#[cfg(not(target_arch = "x86_64"))]
+impl Avx {
+    pub fn detect() -> Option<Avx> {
+        None
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use super::Lanes;
+    use std::arch::x86_64::*;
+
+    /// Proof that the CPU has AVX: only [`Avx::detect`] makes one.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Avx(());
+
+    impl Avx {
+        pub fn detect() -> Option<Avx> {
+            std::is_x86_feature_detected!("avx").then_some(Avx(()))
+        }
+    }
+
+    /// Eight f32 lanes in a 256-bit AVX register. Every way to make one takes an [`Avx`],
+    /// so the instructions below only ever run where the CPU has them; they become single
+    /// instructions in callers compiled with `#[target_feature(enable = "avx")]` (and calls,
+    /// correct but slow, elsewhere).
+    #[derive(Clone, Copy, Debug)]
+    #[repr(transparent)]
+    pub struct F8(__m256);
+
+    // SAFETY (every `unsafe` block below): an `F8` or an `Avx` exists, so the CPU has AVX;
+    // the loads read exactly the 16 bytes of a `[f32; 4]`.
+    impl F8 {
+        /// Lanes 0–3 from `lo`, 4–7 from `hi`.
+        #[inline(always)]
+        pub fn join(_: Avx, lo: &[f32; 4], hi: &[f32; 4]) -> F8 {
+            unsafe { F8(_mm256_loadu2_m128(hi.as_ptr(), lo.as_ptr())) }
+        }
+
+        #[inline(always)]
+        fn mask(v: __m256) -> u32 {
+            unsafe { _mm256_movemask_ps(v) as u32 }
+        }
+    }
+
+    impl Lanes for F8 {
+        type Isa = Avx;
+        type Array = [f32; 8];
+        #[inline(always)]
+        fn splat(_: Avx, v: f32) -> F8 {
+            unsafe { F8(_mm256_set1_ps(v)) }
+        }
+        #[inline(always)]
+        fn add(self, o: F8) -> F8 {
+            unsafe { F8(_mm256_add_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn sub(self, o: F8) -> F8 {
+            unsafe { F8(_mm256_sub_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn mul(self, o: F8) -> F8 {
+            unsafe { F8(_mm256_mul_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn div(self, o: F8) -> F8 {
+            unsafe { F8(_mm256_div_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn min(self, o: F8) -> F8 {
+            unsafe { F8(_mm256_min_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn max(self, o: F8) -> F8 {
+            unsafe { F8(_mm256_max_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn abs(self) -> F8 {
+            unsafe { F8(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0)) }
+        }
+        #[inline(always)]
+        fn le(self, o: F8) -> u32 {
+            unsafe { F8::mask(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn lt(self, o: F8) -> u32 {
+            unsafe { F8::mask(_mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn eq(self, o: F8) -> u32 {
+            unsafe { F8::mask(_mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn to_array(self) -> [f32; 8] {
+            let mut out = [0.0; 8];
+            unsafe { _mm256_storeu_ps(out.as_mut_ptr(), self.0) };
+            out
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::F4;
@@ -221,5 +406,37 @@ mod tests {
         // NaN lanes take the second operand, which the slab test relies on.
         assert_eq!(a.min(b).to_array()[3], 2.0);
         assert_eq!(a.max(b).to_array()[3], 2.0);
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn eight_lanes_as_two_fours() {
+        use super::{Avx, Lanes, F8};
+        let Some(avx) = Avx::detect() else {
+            return;
+        };
+        let lo = [1.0, -2.0, 3.0, f32::NAN];
+        let hi = [-0.5, 2.0, 0.0, 7.0];
+        let a = F8::join(avx, &lo, &hi);
+        let b = F8::splat(avx, 2.0);
+        let ones = F8::splat(avx, 1.0);
+        let (a4, b4) = (F4::from_array(lo), F4::from_array(hi));
+        let halves = |m: u32| (m & 0xF, m >> 4);
+        assert_eq!(
+            halves(a.le(b)),
+            (a4.le(F4::splat(2.0)), b4.le(F4::splat(2.0)))
+        );
+        assert_eq!(a.lt(ones), 0b0010 | 0b0101 << 4);
+        assert_eq!(a.eq(b), 0b0010 << 4);
+        let sum = a.add(b).sub(ones).mul(b).div(b).to_array();
+        assert_eq!(sum[..3], [2.0, -1.0, 4.0]);
+        assert!(sum[3].is_nan());
+        assert_eq!(sum[4..], [0.5, 3.0, 1.0, 8.0]);
+        // NaN lanes take the second operand, as in four lanes.
+        assert_eq!(a.min(b).to_array()[3], 2.0);
+        assert_eq!(a.max(b).to_array()[3], 2.0);
+        assert_eq!(a.abs().to_array()[1], 2.0);
+        assert_eq!(a.min(b).to_array()[4..], [-0.5, 2.0, 0.0, 2.0]);
+        assert_eq!(a.max(b).to_array()[4..], [2.0, 2.0, 2.0, 7.0]);
     }
 }
