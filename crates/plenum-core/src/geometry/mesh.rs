@@ -500,16 +500,16 @@ impl TriangleMesh {
         t_max: &mut f64,
         search: &mut Search,
     ) -> bool {
-        // Prepared at the first leaf: most rays that miss never reach one.
-        let r = search
-            .sheared
-            .get_or_insert_with(|| ShearedRay::new(search.ray));
         // One copy of the loop per axis the ray runs along, so the permutation is static.
-        let (ray, hit) = (search.ray, &mut search.hit);
-        match r.axes[2] {
-            0 => self.search_run_along::<0, NEAREST, PADDED>(avx, run, t_max, r, ray, hit),
-            1 => self.search_run_along::<1, NEAREST, PADDED>(avx, run, t_max, r, ray, hit),
-            _ => self.search_run_along::<2, NEAREST, PADDED>(avx, run, t_max, r, ray, hit),
+        // The axis is found at the first leaf: most rays that miss never reach one.
+        let kz = match &search.sheared {
+            Some(r) => r.kz,
+            None => search.ray.direction.max_abs_axis(),
+        };
+        match kz {
+            0 => self.search_run_along::<0, NEAREST, PADDED>(avx, run, t_max, search),
+            1 => self.search_run_along::<1, NEAREST, PADDED>(avx, run, t_max, search),
+            _ => self.search_run_along::<2, NEAREST, PADDED>(avx, run, t_max, search),
         }
     }
 
@@ -520,10 +520,12 @@ impl TriangleMesh {
         avx: Option<Avx>,
         run: Range<usize>,
         t_max: &mut f64,
-        r: &ShearedRay,
-        ray: &Ray,
-        hit: &mut Option<HitRecord>,
+        search: &mut Search,
     ) -> bool {
+        let Search {
+            ray, sheared, hit, ..
+        } = search;
+        let r = sheared.get_or_insert_with(|| ShearedRay::along::<KZ>(ray));
         debug_assert!(!PADDED || run.start % LANES == 0);
         let skip = run.start % LANES;
         let mut from = !0u32 << skip;
@@ -765,28 +767,29 @@ struct Search<'r> {
 /// A ray prepared for the watertight test: axes permuted so the direction's largest
 /// component is z, and the shear that turns the ray into the +z axis (all in f32).
 struct ShearedRay {
-    axes: [usize; 3],
+    /// The axis that becomes z; x and y are the next two in turn.
+    kz: usize,
     origin: [f32; 3],
     shear: [f32; 3],
 }
 
 impl ShearedRay {
-    #[inline]
-    fn new(ray: &Ray) -> ShearedRay {
-        // Arrays indexed through a table: a `Vec3` indexed by a variable axis branches.
-        const NEXT: [usize; 3] = [1, 2, 0];
-        let kz = ray.direction.max_abs_axis();
-        let (kx, ky) = (NEXT[kz], NEXT[NEXT[kz]]);
+    /// For a ray whose direction's largest component is along `KZ`: the permutation is a
+    /// constant of the code, the ray's numbers read without an index.
+    #[inline(always)]
+    fn along<const KZ: usize>(ray: &Ray) -> ShearedRay {
+        debug_assert_eq!(KZ, ray.direction.max_abs_axis());
+        let (kx, ky) = ((KZ + 1) % 3, (KZ + 2) % 3);
         let (o, d) = (ray.origin, ray.direction);
-        let o = [o.x, o.y, o.z].map(|v| v as f32);
-        let d = [d.x, d.y, d.z].map(|v| v as f32);
+        let o = [o.x as f32, o.y as f32, o.z as f32];
+        let d = [d.x as f32, d.y as f32, d.z as f32];
         // The three quotients in one division.
         let [sx, sy, sz, _] = F4::from_array([-d[kx], -d[ky], 1.0, 1.0])
-            .div(F4::splat(d[kz]))
+            .div(F4::splat(d[KZ]))
             .to_array();
         ShearedRay {
-            axes: [kx, ky, kz],
-            origin: [kx, ky, kz].map(|a| o[a]),
+            kz: KZ,
+            origin: [o[kx], o[ky], o[KZ]],
             shear: [sx, sy, sz],
         }
     }
