@@ -7,33 +7,12 @@ fn plenum() -> Command {
     Command::new(env!("CARGO_BIN_EXE_plenum"))
 }
 
-/// A fresh folder per test.
-fn temp_dir(name: &str) -> TempDir {
-    let dir = std::env::temp_dir().join(format!("plenum-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    TempDir(dir)
-}
-
-/// A test's folder, removed with what it holds when the test ends.
-struct TempDir(PathBuf);
-
-impl std::ops::Deref for TempDir {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<Path> for TempDir {
-    fn as_ref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
+/// A fresh folder per test, removed with what it holds when the test ends.
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("plenum-cli-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
@@ -48,7 +27,8 @@ fn stderr(o: &Output) -> String {
 
 #[test]
 fn renders_the_builtin_scene_in_every_format() {
-    let dir = temp_dir("formats");
+    let tmp = temp_dir("formats");
+    let dir = tmp.path();
     for ext in ["png", "exr", "pfm", "hdr"] {
         let out = dir.join(format!("w.{ext}"));
         let o = plenum()
@@ -77,7 +57,8 @@ fn renders_the_builtin_scene_in_every_format() {
 #[test]
 fn example_scenes_render() {
     let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
-    let dir = temp_dir("examples");
+    let tmp = temp_dir("examples");
+    let dir = tmp.path();
     let mut count = 0;
     for entry in std::fs::read_dir(&scenes).unwrap() {
         let path = entry.unwrap().path();
@@ -145,7 +126,8 @@ fn trace_pixel_shows_the_ray_tree() {
 /// Each bad scene exits with code 2 and names file:line:column and what was expected.
 #[test]
 fn bad_scenes_give_located_errors() {
-    let dir = temp_dir("errors");
+    let tmp = temp_dir("errors");
+    let dir = tmp.path();
     let cases = [
         (
             "[[objects]]\ntype = \"sphere\"\nradus = 1\n",
@@ -244,7 +226,8 @@ fn bad_scenes_give_located_errors() {
 /// Ctrl-C during a render writes what was rendered and exits 130.
 #[test]
 fn interrupt_writes_the_partial_image() {
-    let dir = temp_dir("interrupt");
+    let tmp = temp_dir("interrupt");
+    let dir = tmp.path();
     let out = dir.join("partial.png");
     let child = plenum()
         .args([
@@ -275,7 +258,8 @@ fn interrupt_writes_the_partial_image() {
 
 #[test]
 fn nff_files_render_and_report_located_errors() {
-    let dir = temp_dir("nff");
+    let tmp = temp_dir("nff");
+    let dir = tmp.path();
     let good = write(
         &dir,
         "ok.nff",
@@ -306,7 +290,8 @@ fn nff_files_render_and_report_located_errors() {
 
 #[test]
 fn convert_writes_a_native_scene_that_renders() {
-    let dir = temp_dir("convert");
+    let tmp = temp_dir("convert");
+    let dir = tmp.path();
     let nff = write(
         &dir,
         "in.nff",

@@ -7,35 +7,15 @@ use plenum_core::render::{render, trace_pixel, RenderSettings};
 use plenum_core::sampling::PixelSampler;
 use plenum_core::{Color, Vec3};
 use plenum_scene::{load_scene, parse_scene, LoadedScene};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-fn temp_dir(name: &str) -> TempDir {
-    let dir = std::env::temp_dir().join(format!("plenum-scene-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    TempDir(dir)
-}
-
-/// A test's folder, removed with what it holds when the test ends.
-struct TempDir(PathBuf);
-
-impl std::ops::Deref for TempDir {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<Path> for TempDir {
-    fn as_ref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
+/// A fresh folder per test, removed with what it holds when the test ends.
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("plenum-scene-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn settings(l: &LoadedScene) -> RenderSettings {
@@ -51,7 +31,8 @@ fn settings(l: &LoadedScene) -> RenderSettings {
 /// texel, decoded from sRGB to linear.
 #[test]
 fn image_texture_is_read_relative_to_the_scene_and_decoded_to_linear() {
-    let dir = temp_dir("texture");
+    let tmp = temp_dir("texture");
+    let dir = tmp.path();
     let texels = [
         [1.0, 0.0, 0.0],
         [0.0, 1.0, 0.0],
@@ -102,7 +83,8 @@ vertices = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
 
 #[test]
 fn obj_meshes_load_beside_the_scene_and_instances_share_them() {
-    let dir = temp_dir("instances");
+    let tmp = temp_dir("instances");
+    let dir = tmp.path();
     std::fs::write(
         dir.join("tri.obj"),
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nf 1//1 2//2 3//3\n",
