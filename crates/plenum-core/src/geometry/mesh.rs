@@ -445,8 +445,8 @@ impl TriangleMesh {
     /// if `NEAREST`, else returns false at the first. A structure's run is `PADDED`: it
     /// starts a block, and the lanes of its last block past its end are padding, which
     /// misses (NaN corners). Otherwise (brute force's single slots) lanes outside the run
-    /// are left out. Kept out of the traversal loop: inlined there, it leaves the loop too
-    /// few registers.
+    /// are left out. The loops themselves (`search_run_sse`, `search_run_avx`) are kept out
+    /// of the traversal loop: inlined there, they leave it too few registers.
     #[inline(always)]
     fn search_run<const NEAREST: bool, const PADDED: bool>(
         &self,
