@@ -548,11 +548,21 @@ impl TriangleMesh {
                     #[cfg(target_arch = "x86_64")]
                     Some(avx) if pair => {
                         let pair = &*(self.blocks.as_ptr().add(b) as *const [Block; 2]);
-                        self.intersect_lanes_along::<KZ, F8>(avx, r, ray, pair, base, lanes, *t_max)
+                        self.intersect_lanes_along::<KZ, NEAREST, F8>(
+                            avx, r, ray, pair, base, lanes, *t_max,
+                        )
                     }
                     _ => {
                         let block = self.blocks.get_unchecked(b);
-                        self.intersect_lanes_along::<KZ, F4>((), r, ray, block, base, lanes, *t_max)
+                        self.intersect_lanes_along::<KZ, NEAREST, F4>(
+                            (),
+                            r,
+                            ray,
+                            block,
+                            base,
+                            lanes,
+                            *t_max,
+                        )
                     }
                 }
             };
@@ -569,10 +579,11 @@ impl TriangleMesh {
     }
 
     /// The watertight test on the triangles of slots `base..` held in `blocks`, one lane of
-    /// `V` each, against the lanes set in `lanes`.
+    /// `V` each, against the lanes set in `lanes`: the nearest hit if `NEAREST`, else the
+    /// first found.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn intersect_lanes_along<const KZ: usize, V: BlockLanes>(
+    fn intersect_lanes_along<const KZ: usize, const NEAREST: bool, V: BlockLanes>(
         &self,
         isa: V::Isa,
         r: &ShearedRay,
@@ -649,6 +660,10 @@ impl TriangleMesh {
                         v: (e2[lane] / det[lane]) as f64,
                         part: (base + lane) as u32,
                     });
+                }
+                if !NEAREST {
+                    // Any hit will do: the first lane's, and no edge case settled in f64.
+                    return best;
                 }
             }
         }
