@@ -39,8 +39,11 @@ const TRAVERSAL_COST: f32 = 1.0;
 /// Subtrees with more items than this are built in parallel.
 const PARALLEL_ITEMS: usize = 4096;
 
-/// A child reference: an interior node's index, or a leaf (top bit set) with its item run.
+/// A child reference: an interior node's byte offset in the nodes (its index times
+/// [`NODE_BYTES`], so that the traversal adds it to the base without a shift), or a leaf (top
+/// bit set) with its item run.
 const LEAF_BIT: u32 = 1 << 31;
+const NODE_BYTES: u32 = std::mem::size_of::<Node>() as u32;
 const COUNT_SHIFT: u32 = 27;
 const START_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 /// Longest run a leaf can hold.
@@ -270,9 +273,14 @@ impl Bvh {
         self.nodes.len() * std::mem::size_of::<Node>() + self.order.len() * 4
     }
 
-    /// Appends a node holding `children` (at most eight), then their subtrees depth-first.
+    /// Appends a node holding `children` (at most eight), then their subtrees depth-first,
+    /// and returns its reference.
     fn flatten_children(&mut self, children: &[BuildNode]) -> u32 {
         let index = self.nodes.len();
+        assert!(
+            index < (LEAF_BIT / NODE_BYTES) as usize,
+            "too many nodes for a BVH node reference"
+        );
         let mut node = Node {
             planes: [
                 [f32::INFINITY; WIDTH],
@@ -300,7 +308,7 @@ impl Bvh {
             };
             self.nodes[index].children[slot] = reference;
         }
-        index as u32
+        index as u32 * NODE_BYTES
     }
 
     /// Asks for a child the traversal will visit later, so it arrives while others are
@@ -312,7 +320,7 @@ impl Bvh {
         #[cfg(target_arch = "x86_64")]
         {
             let is_node = child & LEAF_BIT == 0;
-            let node = self.nodes.as_ptr().wrapping_add(child as usize) as *const i8;
+            let node = (self.nodes.as_ptr() as *const i8).wrapping_add(child as usize);
             let leaf = items
                 .base
                 .wrapping_add((child & START_MASK) as usize * items.stride)
@@ -469,9 +477,15 @@ impl Bvh {
                 }
                 far = round_up_distance(t_max);
             } else {
-                debug_assert!((current as usize) < self.nodes.len());
-                // SAFETY: interior references are indices of nodes, written by `flatten`.
-                let node = unsafe { self.nodes.get_unchecked(current as usize) };
+                debug_assert!(current % NODE_BYTES == 0);
+                debug_assert!(((current / NODE_BYTES) as usize) < self.nodes.len());
+                // SAFETY: interior references are byte offsets of nodes, written by
+                // `flatten_children`.
+                let node = unsafe {
+                    &*(self.nodes.as_ptr() as *const u8)
+                        .add(current as usize)
+                        .cast::<Node>()
+                };
                 let (near, hits) = test(&node.planes, far);
                 // Eight lanes: indices below stay under eight.
                 let mut hits = hits & node.used & 0xFF;
