@@ -316,14 +316,14 @@ impl Bvh {
     /// of four triangles, wherever it starts in its first line). Without branches: whether a
     /// child is a leaf is a coin toss to the branch predictor.
     #[inline(always)]
-    fn prefetch(&self, child: u32, items: LeafItems) {
+    fn prefetch<const STRIDE: usize>(&self, child: u32, items: LeafItems<STRIDE>) {
         #[cfg(target_arch = "x86_64")]
         {
             let is_node = child & LEAF_BIT == 0;
             let node = (self.nodes.as_ptr() as *const i8).wrapping_add(child as usize);
             let leaf = items
                 .base
-                .wrapping_add((child & START_MASK) as usize * items.stride)
+                .wrapping_add((child & START_MASK) as usize * STRIDE)
                 as *const i8;
             let p = std::hint::select_unpredictable(is_node, node, leaf);
             // SAFETY: prefetching is only a hint; it never faults, so the address needs no
@@ -344,7 +344,8 @@ impl Bvh {
     /// and returns false to stop.
     #[inline]
     pub fn traverse(&self, ray: &Ray, t_max: f64, mut visit: impl FnMut(&[u32], &mut f64) -> bool) {
-        self.traverse_runs(ray, t_max, LeafItems::of(&self.order), |run, t_max| {
+        let items = LeafItems::<{ std::mem::size_of::<u32>() }>::at(&self.order);
+        self.traverse_runs(ray, t_max, items, |run, t_max| {
             visit(&self.order[run], t_max)
         });
     }
@@ -385,14 +386,14 @@ impl Bvh {
     /// `items` says where the runs' items lie, so that a leaf's items can be fetched ahead
     /// of their test.
     #[inline]
-    pub fn traverse_runs(
+    pub fn traverse_runs<const STRIDE: usize>(
         &self,
         ray: &Ray,
         t_max: f64,
-        items: LeafItems,
+        items: LeafItems<STRIDE>,
         visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
-        self.traverse_dispatch::<true>(ray, t_max, items, visit);
+        self.traverse_dispatch::<true, STRIDE>(ray, t_max, items, visit);
     }
 
     /// [`Bvh::traverse_runs`] for a caller that stops at any hit, such as a shadow ray: the
@@ -400,22 +401,22 @@ impl Bvh {
     /// and `visit` must not lower `t_max` (it stops instead), which spares comparing each
     /// waiting child's distance with it.
     #[inline]
-    pub fn traverse_runs_any_order(
+    pub fn traverse_runs_any_order<const STRIDE: usize>(
         &self,
         ray: &Ray,
         t_max: f64,
-        items: LeafItems,
+        items: LeafItems<STRIDE>,
         visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
-        self.traverse_dispatch::<false>(ray, t_max, items, visit);
+        self.traverse_dispatch::<false, STRIDE>(ray, t_max, items, visit);
     }
 
     #[inline(always)]
-    fn traverse_dispatch<const NEAREST_FIRST: bool>(
+    fn traverse_dispatch<const NEAREST_FIRST: bool, const STRIDE: usize>(
         &self,
         ray: &Ray,
         t_max: f64,
-        items: LeafItems,
+        items: LeafItems<STRIDE>,
         visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
         if self.nodes.is_empty() {
@@ -424,10 +425,10 @@ impl Bvh {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx") && std::is_x86_feature_detected!("fma") {
             // SAFETY: the CPU has AVX and FMA.
-            return unsafe { self.traverse_avx::<NEAREST_FIRST>(ray, t_max, items, visit) };
+            return unsafe { self.traverse_avx::<NEAREST_FIRST, STRIDE>(ray, t_max, items, visit) };
         }
         let r = BoxRay::new(ray);
-        self.traverse_with::<NEAREST_FIRST>(t_max, items, visit, |planes, far| {
+        self.traverse_with::<NEAREST_FIRST, STRIDE>(t_max, items, visit, |planes, far| {
             r.test8(planes, F4::splat(far))
         });
     }
@@ -438,16 +439,16 @@ impl Bvh {
     /// The CPU must support AVX and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,fma")]
-    unsafe fn traverse_avx<const NEAREST_FIRST: bool>(
+    unsafe fn traverse_avx<const NEAREST_FIRST: bool, const STRIDE: usize>(
         &self,
         ray: &Ray,
         t_max: f64,
-        items: LeafItems,
+        items: LeafItems<STRIDE>,
         visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
         // SAFETY: this function runs only where the CPU has AVX and FMA.
         let wide = unsafe { BoxRayAvx::new(ray) };
-        self.traverse_with::<NEAREST_FIRST>(t_max, items, visit, |planes, far| unsafe {
+        self.traverse_with::<NEAREST_FIRST, STRIDE>(t_max, items, visit, |planes, far| unsafe {
             wide.test8(planes, far)
         });
     }
@@ -455,10 +456,10 @@ impl Bvh {
     /// The traversal, with `test(planes, far)` giving a node's eight entry distances and
     /// the mask of the children the ray crosses before `far`.
     #[inline(always)]
-    fn traverse_with<const NEAREST_FIRST: bool>(
+    fn traverse_with<const NEAREST_FIRST: bool, const STRIDE: usize>(
         &self,
         t_max: f64,
-        items: LeafItems,
+        items: LeafItems<STRIDE>,
         mut visit: impl FnMut(Range<usize>, &mut f64) -> bool,
         test: impl Fn(&[[f32; WIDTH]; 6], f32) -> ([f32; WIDTH], u32),
     ) {
@@ -563,24 +564,20 @@ impl Bvh {
     }
 }
 
-/// Where the items a leaf's run indexes lie, for prefetching.
+/// Where the items a leaf's run indexes lie, for prefetching: from the start of `items`,
+/// `STRIDE` bytes per item (a constant, so that the traversal multiplies by an immediate and
+/// keeps no register for it).
 #[derive(Clone, Copy)]
-pub struct LeafItems {
+pub struct LeafItems<const STRIDE: usize> {
     base: *const u8,
-    stride: usize,
 }
 
-impl LeafItems {
-    /// One item per element of `items`.
-    pub fn of<T>(items: &[T]) -> LeafItems {
-        LeafItems::packed(items, 1)
-    }
-
-    /// `per_block` items per element of `blocks`, such as four triangles to a SIMD block.
-    pub fn packed<T>(blocks: &[T], per_block: usize) -> LeafItems {
+impl<const STRIDE: usize> LeafItems<STRIDE> {
+    /// Items laid out from the start of `items`, such as a mesh's blocks of four triangles
+    /// (a block's size over four).
+    pub fn at<T>(items: &[T]) -> LeafItems<STRIDE> {
         LeafItems {
-            base: blocks.as_ptr() as *const u8,
-            stride: std::mem::size_of::<T>() / per_block,
+            base: items.as_ptr() as *const u8,
         }
     }
 }

@@ -409,7 +409,7 @@ impl TriangleMesh {
         };
         match &self.accel {
             Accel::Bvh(bvh) => {
-                let items = LeafItems::packed(&self.blocks, LANES);
+                let items = LeafItems::<{ std::mem::size_of::<Block>() / LANES }>::at(&self.blocks);
                 if NEAREST {
                     bvh.traverse_runs(ray, t_max, items, visit_run);
                 } else {
