@@ -468,23 +468,25 @@ impl Bvh {
         // Uninitialised: only entries below `top`, all written first, are read.
         let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK];
         let mut top = 0usize;
-        let mut current = 0u32;
+        // A reference widened once where it is read: kept as u32, it is widened again
+        // before every use as an offset.
+        let mut current = 0usize;
         loop {
-            if current & LEAF_BIT != 0 {
-                let start = (current & START_MASK) as usize;
-                let count = ((current & !LEAF_BIT) >> COUNT_SHIFT) as usize;
+            if current & LEAF_BIT as usize != 0 {
+                let start = current & START_MASK as usize;
+                let count = (current & !(LEAF_BIT as usize)) >> COUNT_SHIFT;
                 if !visit(start..start + count, &mut t_max) {
                     return;
                 }
                 far = round_up_distance(t_max);
             } else {
-                debug_assert!(current % NODE_BYTES == 0);
-                debug_assert!(((current / NODE_BYTES) as usize) < self.nodes.len());
+                debug_assert!(current % NODE_BYTES as usize == 0);
+                debug_assert!(current / (NODE_BYTES as usize) < self.nodes.len());
                 // SAFETY: interior references are byte offsets of nodes, written by
                 // `flatten_children`.
                 let node = unsafe {
                     &*(self.nodes.as_ptr() as *const u8)
-                        .add(current as usize)
+                        .add(current)
                         .cast::<Node>()
                 };
                 let (near, hits) = test(&node.planes, far);
@@ -498,13 +500,13 @@ impl Bvh {
                     // branch predictor.
                     self.prefetch(node.children[first], items);
                     if hits == 0 {
-                        current = node.children[first];
+                        current = node.children[first] as usize;
                         continue;
                     }
                     if !NEAREST_FIRST {
                         // Any order will do (as for shadow rays): no distances kept, since
                         // `t_max` never falls below one of a child already found to cross.
-                        current = node.children[first];
+                        current = node.children[first] as usize;
                         while hits != 0 {
                             let i = hits.trailing_zeros() as usize & 7;
                             hits &= hits - 1;
@@ -542,7 +544,7 @@ impl Bvh {
                         }
                         top += 1;
                     }
-                    current = best.0;
+                    current = best.0 as usize;
                     continue;
                 }
             }
@@ -556,7 +558,7 @@ impl Bvh {
                 // SAFETY: entries below `top` were written when pushed.
                 let (next, near) = unsafe { stack.get_unchecked(top).assume_init() };
                 if !NEAREST_FIRST || near <= limit {
-                    current = next;
+                    current = next as usize;
                     break;
                 }
             }
