@@ -478,7 +478,10 @@ impl Bvh {
                 if !visit(start..start + count, &mut t_max) {
                     return;
                 }
-                far = round_up_distance(t_max);
+                if NEAREST_FIRST {
+                    // In any order, `visit` stops instead of lowering `t_max`.
+                    far = round_up_distance(t_max);
+                }
             } else {
                 debug_assert!(current % NODE_BYTES as usize == 0);
                 debug_assert!(current / (NODE_BYTES as usize) < self.nodes.len());
