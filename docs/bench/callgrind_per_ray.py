@@ -5,6 +5,7 @@
         /tmp/v3/release/plenum bench --mesh MESH --rays RAYS --threads 1 --passes 1
     docs/bench/callgrind_per_ray.py cg.out --rays N            # per-ray totals
     docs/bench/callgrind_per_ray.py cg.out --rays N --asm FUNCTION --binary BIN
+    docs/bench/callgrind_per_ray.py cg.out --rays N --copies FUNCTION --binary BIN
 
 With `--passes 1` the bench traces every ray twice (a warm-up and one pass) for each of the
 closest and any hit, so N is twice the number of rays in the file. The totals are inclusive
@@ -12,7 +13,10 @@ closest and any hit, so N is twice the number of rays in the file. The totals ar
 one closest-hit and one any-hit ray cost; then the functions' own counts, largest first.
 `--asm` prints the disassembly of one function (its full name, as listed) with how many
 times each instruction ran, for reading where the count goes: a block test's gather, the
-spills around a call, a node visit. `--dump-instr=yes` is needed for that only.
+spills around a call, a node visit. `--copies` splits a function's count among its copies
+(the monomorphised instances that share its name: the closest- and any-hit traversals, say),
+each with how often it was entered, from the binary's symbol table. `--dump-instr=yes` is
+needed for these two only.
 Python 3 standard library and objdump.
 """
 
@@ -88,13 +92,28 @@ def print_asm(binary, counts):
             print(f"{count:>10} {match.group(1)} {match.group(2)}")
 
 
+def print_copies(binary, counts, rays):
+    """Per copy of a function (by the symbols' addresses): instructions per ray and entry."""
+    symbols = sorted({int(line.split()[0], 16) for line in subprocess.run(
+        ["nm", binary], capture_output=True, text=True, check=True).stdout.splitlines()
+        if len(line.split()) == 3 and line.split()[1] in "tTwW"})
+    for start in sorted({max(s for s in symbols if s <= a) for a in counts}):
+        end = min((s for s in symbols if s > start), default=float("inf"))
+        total = sum(c for a, c in counts.items() if start <= a < end)
+        entries = counts.get(start, 0)
+        per_entry = f"{total / entries:8.1f} per entry" if entries else ""
+        print(f"{start:#x}: {total / rays:8.1f} per ray, entered {entries / rays:6.3f} "
+              f"times per ray {per_entry}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("profile")
     parser.add_argument("--rays", type=int, required=True,
                         help="traces of each kind: twice the file's rays with --passes 1")
     parser.add_argument("--asm", metavar="FUNCTION")
-    parser.add_argument("--binary", help="the profiled executable, for --asm")
+    parser.add_argument("--copies", metavar="FUNCTION")
+    parser.add_argument("--binary", help="the profiled executable, for --asm and --copies")
     parser.add_argument("--top", type=int, default=8)
     args = parser.parse_args()
     own, callees, by_address = parse(args.profile)
@@ -109,6 +128,10 @@ def main():
         if not args.binary or args.asm not in by_address or not by_address[args.asm]:
             sys.exit("--asm needs --binary and a profile made with --dump-instr=yes")
         print_asm(args.binary, by_address[args.asm])
+    if args.copies:
+        if not args.binary or not by_address.get(args.copies):
+            sys.exit("--copies needs --binary and a profile made with --dump-instr=yes")
+        print_copies(args.binary, by_address[args.copies], args.rays)
 
 
 if __name__ == "__main__":
