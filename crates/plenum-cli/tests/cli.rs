@@ -50,7 +50,7 @@ fn renders_the_builtin_scene_in_every_format() {
         );
     }
     // No arguments at all: the built-in scene to plenum.png in the working directory.
-    let o = plenum().current_dir(&dir).arg("--help").output().unwrap();
+    let o = plenum().current_dir(dir).arg("--help").output().unwrap();
     assert!(o.status.success());
 }
 
@@ -199,7 +199,7 @@ fn bad_scenes_give_located_errors() {
         ),
     ];
     for (i, (text, location, message)) in cases.iter().enumerate() {
-        let scene = write(&dir, &format!("bad{i}.toml"), text);
+        let scene = write(dir, &format!("bad{i}.toml"), text);
         let o = plenum()
             .arg("render")
             .arg(&scene)
@@ -261,7 +261,7 @@ fn nff_files_render_and_report_located_errors() {
     let tmp = temp_dir("nff");
     let dir = tmp.path();
     let good = write(
-        &dir,
+        dir,
         "ok.nff",
         "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0\nresolution 32 32\nl 2 2 5\nf 1 0 0 1 0 0 0 1\ns 0 0 0 1\n",
     );
@@ -278,7 +278,7 @@ fn nff_files_render_and_report_located_errors() {
         "{}",
         stderr(&o)
     );
-    let bad = write(&dir, "bad.nff", "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0\nresolution 32 32\nf 1 0 0 1 0 0 0 1\ns 0 0 x 1\n");
+    let bad = write(dir, "bad.nff", "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0\nresolution 32 32\nf 1 0 0 1 0 0 0 1\ns 0 0 x 1\n");
     let o = plenum().arg("render").arg(&bad).output().unwrap();
     assert_eq!(o.status.code(), Some(2));
     assert!(
@@ -293,7 +293,7 @@ fn convert_writes_a_native_scene_that_renders() {
     let tmp = temp_dir("convert");
     let dir = tmp.path();
     let nff = write(
-        &dir,
+        dir,
         "in.nff",
         "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0\nresolution 32 32\nl 2 2 5\nf 1 0 0 1 0 0 0 1\ns 0 0 0 1\n",
     );
@@ -318,7 +318,7 @@ fn convert_writes_a_native_scene_that_renders() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
-    let bad = write(&dir, "bad.nff", "v\nfrom 0 0 5\n");
+    let bad = write(dir, "bad.nff", "v\nfrom 0 0 5\n");
     let o = plenum()
         .arg("convert")
         .arg(&bad)

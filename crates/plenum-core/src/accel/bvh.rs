@@ -483,7 +483,7 @@ impl Bvh {
                     far = round_up_distance(t_max);
                 }
             } else {
-                debug_assert!(current % NODE_BYTES as usize == 0);
+                debug_assert!(current.is_multiple_of(NODE_BYTES as usize));
                 debug_assert!(current / (NODE_BYTES as usize) < self.nodes.len());
                 // SAFETY: interior references are byte offsets of nodes, written by
                 // `flatten_children`.

@@ -526,7 +526,7 @@ impl TriangleMesh {
             ray, sheared, hit, ..
         } = search;
         let r = sheared.get_or_insert_with(|| ShearedRay::along::<KZ>(ray));
-        debug_assert!(!PADDED || run.start % LANES == 0);
+        debug_assert!(!PADDED || run.start.is_multiple_of(LANES));
         let skip = run.start % LANES;
         let mut from = !0u32 << skip;
         let mut base = run.start - skip;
