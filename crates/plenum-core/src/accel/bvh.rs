@@ -16,6 +16,7 @@
 //! box out of the ray's way.
 
 use super::append_padded;
+use super::pages::LargeArray;
 #[cfg(target_arch = "x86_64")]
 use super::ray_f32::BoxRayAvx;
 use super::ray_f32::{round_down, round_up, round_up_distance, BoxRay};
@@ -52,7 +53,7 @@ const EMPTY: u32 = LEAF_BIT;
 
 /// Eight child boxes as six planes of eight lanes: min x, y, z then max x, y, z. Four cache
 /// lines exactly.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Node {
     planes: [[f32; WIDTH]; 6],
@@ -63,7 +64,8 @@ struct Node {
 
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    nodes: Vec<Node>,
+    /// On huge pages where there are many (see [`super::pages`]).
+    nodes: LargeArray<Node>,
     /// Item indices, grouped by leaf.
     order: Vec<u32>,
     bounds: Bounds3,
@@ -245,20 +247,20 @@ impl Bvh {
         let builder = Builder { max_leaf, block };
         let mut root = builder.build(&mut items, 0, 0);
         root.fill();
-        let mut bvh = Bvh {
-            nodes: Vec::with_capacity(items.len() / 2 + 1),
-            order: items.iter().map(|it| it.index).collect(),
-            bounds,
-        };
+        let mut nodes = Vec::with_capacity(items.len() / 2 + 1);
         match root {
             leaf @ BuildNode::Leaf { .. } => {
-                bvh.flatten_children(&[leaf]);
+                flatten_children(&mut nodes, &[leaf]);
             }
             BuildNode::Inner { children, .. } => {
-                bvh.flatten_children(&children);
+                flatten_children(&mut nodes, &children);
             }
         }
-        bvh
+        Bvh {
+            nodes: nodes.into(),
+            order: items.iter().map(|it| it.index).collect(),
+            bounds,
+        }
     }
 
     pub fn bounds(&self) -> Bounds3 {
@@ -271,44 +273,6 @@ impl Bvh {
 
     pub fn memory_bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<Node>() + self.order.len() * 4
-    }
-
-    /// Appends a node holding `children` (at most eight), then their subtrees depth-first,
-    /// and returns its reference.
-    fn flatten_children(&mut self, children: &[BuildNode]) -> u32 {
-        let index = self.nodes.len();
-        assert!(
-            index < (LEAF_BIT / NODE_BYTES) as usize,
-            "too many nodes for a BVH node reference"
-        );
-        let mut node = Node {
-            planes: [
-                [f32::INFINITY; WIDTH],
-                [f32::INFINITY; WIDTH],
-                [f32::INFINITY; WIDTH],
-                [f32::NEG_INFINITY; WIDTH],
-                [f32::NEG_INFINITY; WIDTH],
-                [f32::NEG_INFINITY; WIDTH],
-            ],
-            children: [EMPTY; WIDTH],
-            used: (1 << children.len()) - 1,
-        };
-        for (slot, child) in children.iter().enumerate() {
-            let b = child.bounds();
-            for a in 0..3 {
-                node.planes[a][slot] = b.lo[a];
-                node.planes[3 + a][slot] = b.hi[a];
-            }
-        }
-        self.nodes.push(node);
-        for (slot, child) in children.iter().enumerate() {
-            let reference = match child {
-                BuildNode::Leaf { start, count, .. } => LEAF_BIT | (count << COUNT_SHIFT) | start,
-                BuildNode::Inner { children, .. } => self.flatten_children(children),
-            };
-            self.nodes[index].children[slot] = reference;
-        }
-        index as u32 * NODE_BYTES
     }
 
     /// Asks for a child the traversal will visit later, so it arrives while others are
@@ -587,6 +551,44 @@ impl<const STRIDE: usize> LeafItems<STRIDE> {
     }
 }
 
+/// Appends a node holding `children` (at most eight), then their subtrees depth-first,
+/// and returns its reference.
+fn flatten_children(nodes: &mut Vec<Node>, children: &[BuildNode]) -> u32 {
+    let index = nodes.len();
+    assert!(
+        index < (LEAF_BIT / NODE_BYTES) as usize,
+        "too many nodes for a BVH node reference"
+    );
+    let mut node = Node {
+        planes: [
+            [f32::INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+        ],
+        children: [EMPTY; WIDTH],
+        used: (1 << children.len()) - 1,
+    };
+    for (slot, child) in children.iter().enumerate() {
+        let b = child.bounds();
+        for a in 0..3 {
+            node.planes[a][slot] = b.lo[a];
+            node.planes[3 + a][slot] = b.hi[a];
+        }
+    }
+    nodes.push(node);
+    for (slot, child) in children.iter().enumerate() {
+        let reference = match child {
+            BuildNode::Leaf { start, count, .. } => LEAF_BIT | (count << COUNT_SHIFT) | start,
+            BuildNode::Inner { children, .. } => flatten_children(nodes, children),
+        };
+        nodes[index].children[slot] = reference;
+    }
+    index as u32 * NODE_BYTES
+}
+
 struct Builder {
     max_leaf: usize,
     /// Items the caller tests at once: a leaf of `block` items costs one test.
@@ -798,7 +800,7 @@ mod tests {
         assert_eq!(order.len() % 4, 0);
         let mut seen = vec![0; boxes.len()];
         let mut covered = vec![false; order.len()];
-        for node in &bvh.nodes {
+        for node in bvh.nodes.iter() {
             for (slot, &child) in node.children.iter().enumerate() {
                 if node.used & (1 << slot) == 0 || child & LEAF_BIT == 0 {
                     continue;

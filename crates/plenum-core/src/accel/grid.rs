@@ -9,6 +9,7 @@
 //! the cells the ray touches up to rounding, which the margin items are filed with covers.
 
 use super::mailbox::{new_owner, Mailbox};
+use super::pages::LargeArray;
 use super::{append_padded, nearest, split_off_large};
 use crate::math::{Bounds3, Ray, Vec3};
 use std::ops::Range;
@@ -36,8 +37,9 @@ pub struct Grid {
     cell_size: Vec3,
     /// 1 / cell_size, or 0 along a flat axis: cells are found by a product, not a quotient.
     inv_cell_size: Vec3,
-    /// Items of cell c are `items[starts[c]..starts[c + 1]]`.
-    starts: Vec<u32>,
+    /// Items of cell c are `items[starts[c]..starts[c + 1]]`; on huge pages where there are
+    /// many cells (see [`super::pages`]).
+    starts: LargeArray<u32>,
     items: Vec<u32>,
     /// Per macro cell: some cell of it holds an item.
     macro_full: Vec<bool>,
@@ -67,7 +69,7 @@ impl Grid {
             resolution: [1; 3],
             cell_size: Vec3::ONE,
             inv_cell_size: Vec3::ONE,
-            starts: vec![0, 0],
+            starts: vec![0, 0].into(),
             items: Vec::new(),
             macro_full: vec![true],
             macro_resolution: [1; 3],
@@ -136,7 +138,7 @@ impl Grid {
                 grid.macro_full[((z / MACRO) * my + y / MACRO) * mx + x / MACRO] = true;
             }
         }
-        grid.starts = counts;
+        grid.starts = counts.into();
         grid.items = items;
         grid
     }
@@ -228,7 +230,7 @@ impl Grid {
         }
         starts.push(padded.len() as u32);
         self.large = Vec::new();
-        self.starts = starts;
+        self.starts = starts.into();
         self.items = Vec::new();
         padded
     }

@@ -1,4 +1,4 @@
-//! Acceleration structures, selectable so their speed-ups can be compared: a four-wide BVH
+//! Acceleration structures, selectable so their speed-ups can be compared: an eight-wide BVH
 //! (the default), a uniform grid, an octree, and none (brute force). The same structures
 //! serve both levels of a scene: the primitives of the scene, and the triangles inside each
 //! mesh.
@@ -13,6 +13,7 @@ mod bvh;
 mod grid;
 mod mailbox;
 mod octree;
+pub(crate) mod pages;
 pub(crate) mod ray_f32;
 pub(crate) mod simd;
 

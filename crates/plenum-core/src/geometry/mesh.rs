@@ -11,6 +11,7 @@
 //! per-vertex materials).
 
 use super::{HitRecord, SurfaceGeometry};
+use crate::accel::pages::LargeArray;
 use crate::accel::ray_f32::{gamma_f32, round_up_distance};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::simd::F8;
@@ -41,9 +42,10 @@ pub struct TriangleMesh {
     /// The triangles' corners, slot `s` in lane `s % 4` of block `s / 4`, in the
     /// structure's order: the mesh's only copy of its positions (shading widens them to
     /// f64, exactly). A grid or an octree holds a triangle once in each of its cells.
-    blocks: Vec<Block>,
+    /// On huge pages where there are many (see [`crate::accel::pages`]).
+    blocks: LargeArray<Block>,
     /// Per slot, the triangle's position in the list the mesh was made from, or [`PAD`].
-    source: Vec<u32>,
+    source: LargeArray<u32>,
     /// Per slot, the triangle's vertex indices where `keeps_indices`; else empty.
     indices: Vec<[u32; 3]>,
     /// The vertex indices the mesh was made with are kept (for normals, uvs, or the caller).
@@ -171,8 +173,8 @@ impl TriangleMesh {
             .map(|t| t.map(|i| positions[i as usize]))
             .collect();
         let mut mesh = TriangleMesh {
-            blocks: Vec::new(),
-            source: Vec::new(),
+            blocks: LargeArray::default(),
+            source: LargeArray::default(),
             indices: Vec::new(),
             keeps_indices: keep_indices,
             normals,
@@ -192,8 +194,8 @@ impl TriangleMesh {
     pub fn with_accel(&self, kind: AccelKind) -> TriangleMesh {
         let (corners, indices) = self.in_source_order();
         let mut mesh = TriangleMesh {
-            blocks: Vec::new(),
-            source: Vec::new(),
+            blocks: LargeArray::default(),
+            source: LargeArray::default(),
             indices: Vec::new(),
             normals: self.normals.clone(),
             uvs: self.uvs.clone(),
@@ -269,7 +271,7 @@ impl TriangleMesh {
         } else {
             Vec::new()
         };
-        self.source = order;
+        self.source = order.into();
         self.accel = accel;
     }
 
@@ -615,7 +617,9 @@ impl TriangleMesh {
             return None;
         }
         // An edge function exactly zero in f32 may be a rounding artefact: settle in f64.
-        let on_edge = (e0.eq(zero) | e1.eq(zero) | e2.eq(zero)) & inside;
+        // Inside, the three are of one sign, so one is zero only where the least or the
+        // greatest is.
+        let on_edge = (least.eq(zero) | greatest.eq(zero)) & inside;
         inside &= !on_edge;
         let det = e0.add(e1).add(e2);
         let sz = shear[2];
@@ -626,29 +630,41 @@ impl TriangleMesh {
         inside &= zero.lt(t) & t.lt(limit) & !det.eq(zero);
         let mut best: Option<HitRecord> = None;
         if inside != 0 {
-            // Is t conservatively positive? (pbrt-v4 §6.8.4, in f32.)
+            // Is t conservatively positive? pbrt-v4's bound δt (§6.8.4, in f32) takes a
+            // division and some forty operations. With M the largest sheared coordinate,
+            // δt·|det| ≤ 3(4γ₃ + 10γ₅)M³ < 42γ₅M³, and t·|det| = |t_scaled|: that settles
+            // nearly every hit but one near the ray's origin, which gets the full bound.
             let max3 = |p: V, q: V, s: V| p.abs().max(q.abs()).max(s.abs());
             let max_z = max3(az, bz, cz);
             let max_x = max3(a[0], b[0], c[0]);
             let max_y = max3(a[1], b[1], c[1]);
-            let delta_z = max_z.mul(splat(gamma_f32(3)));
-            let delta_x = max_x.add(max_z).mul(splat(gamma_f32(5)));
-            let delta_y = max_y.add(max_z).mul(splat(gamma_f32(5)));
-            let delta_e = max_x
-                .mul(max_y)
-                .mul(splat(gamma_f32(2)))
-                .add(delta_y.mul(max_x))
-                .add(delta_x.mul(max_y))
-                .mul(splat(2.0));
-            let max_e = max3(e0, e1, e2);
-            let delta_t = max_e
-                .mul(max_z)
-                .mul(splat(gamma_f32(3)))
-                .add(delta_e.mul(max_z))
-                .add(delta_z.mul(max_e))
-                .mul(splat(3.0))
-                .div(det.abs());
-            inside &= delta_t.lt(t);
+            let m = max_x.max(max_y).max(max_z);
+            // An M³ that overflows is infinite and settles nothing.
+            let settled = m
+                .mul(m)
+                .mul(m)
+                .mul(splat(48.0 * gamma_f32(5)))
+                .lt(t_scaled.abs());
+            if inside & !settled != 0 {
+                let delta_z = max_z.mul(splat(gamma_f32(3)));
+                let delta_x = max_x.add(max_z).mul(splat(gamma_f32(5)));
+                let delta_y = max_y.add(max_z).mul(splat(gamma_f32(5)));
+                let delta_e = max_x
+                    .mul(max_y)
+                    .mul(splat(gamma_f32(2)))
+                    .add(delta_y.mul(max_x))
+                    .add(delta_x.mul(max_y))
+                    .mul(splat(2.0));
+                let max_e = max3(e0, e1, e2);
+                let delta_t = max_e
+                    .mul(max_z)
+                    .mul(splat(gamma_f32(3)))
+                    .add(delta_e.mul(max_z))
+                    .add(delta_z.mul(max_e))
+                    .mul(splat(3.0))
+                    .div(det.abs());
+                inside &= settled | delta_t.lt(t);
+            }
             let (t, e1, e2, det) = (t.to_array(), e1.to_array(), e2.to_array(), det.to_array());
             while inside != 0 {
                 let lane = inside.trailing_zeros() as usize;
@@ -1064,6 +1080,59 @@ mod tests {
             }
             assert!(hits > 2000, "{kind}: {hits} hits");
         }
+    }
+
+    #[test]
+    fn a_ray_leaving_a_triangle_misses_it_and_a_far_one_hits_it() {
+        // Random triangles of every size (seed 5) whose centroid is a point exactly in f32,
+        // corners too: a ray from the centroid, either way, has a distance of pure rounding
+        // noise, which only pbrt's bound rejects (the cheap bound must leave it to that). A
+        // ray from afar to the same point is settled by the cheap bound, at the distance
+        // the f64 test finds.
+        let mut rng = crate::sampling::Rng::new(5, 0);
+        // Multiples of 1/16 under 1024, offsets of quarters times 2^-2..2^6: all sums fit in
+        // f32's 24 bits.
+        let mut multiples = |of: f64, below: f64| {
+            let mut m = || ((rng.uniform() - 0.5) * 2.0 * below / of).round() * of;
+            Vec3::new(m(), m(), m())
+        };
+        let exact = |p: Vec3| Vec3::new(p.x as f32 as f64, p.y as f32 as f64, p.z as f32 as f64);
+        let mut far_hits = 0;
+        for _ in 0..2000 {
+            let centre = multiples(1.0 / 16.0, 1024.0);
+            let scale = 2f64.powi(multiples(1.0, 4.5).x as i32 + 2);
+            let (a, b) = (multiples(0.25, 2.0) * scale, multiples(0.25, 2.0) * scale);
+            let away = multiples(1.0 / 1024.0, 0.5);
+            if a.cross(b).length() < 1e-3 * scale * scale {
+                continue;
+            }
+            let tri = [centre + a, centre + b, centre - a - b];
+            assert_eq!(tri.map(exact), tri);
+            let mesh = TriangleMesh::new(tri.to_vec(), vec![[0, 1, 2]], vec![], vec![]).unwrap();
+            for d in [away, -away] {
+                let leaving = Ray::new(centre, d);
+                assert_eq!(
+                    mesh.intersect(&leaving, f64::INFINITY),
+                    None,
+                    "{tri:?} {d:?}"
+                );
+                assert_eq!(mesh.intersect_any(&leaving, f64::INFINITY), None, "{tri:?}");
+            }
+            let from = exact(centre + away * (scale * 10.0));
+            let arriving = Ray::new(from, centre - from);
+            // Not grazing, where a distance is ill-conditioned.
+            let cos = a.cross(b).normalized().dot(arriving.direction.normalized());
+            if cos.abs() < 0.2 {
+                continue;
+            }
+            if let Some((t, _, _)) = intersect_triangle(&arriving, f64::INFINITY, tri) {
+                let hit = mesh.intersect(&arriving, f64::INFINITY).expect("a far hit");
+                assert!((hit.t - t).abs() <= 1e-5 * t, "{} against {t}", hit.t);
+                assert!(mesh.intersect_any(&arriving, f64::INFINITY).is_some());
+                far_hits += 1;
+            }
+        }
+        assert!(far_hits > 1000, "{far_hits} far hits");
     }
 
     #[test]
