@@ -12,6 +12,7 @@ use std::ops::{Deref, DerefMut};
 use std::ptr::NonNull;
 
 /// The size of a huge page, and the least array worth one.
+#[cfg_attr(not(target_os = "linux"), allow(dead_code))]
 const HUGE_PAGE: usize = 2 << 20;
 
 /// A fixed-length array of `T`, page-aligned and on huge pages from [`HUGE_PAGE`] bytes up.
