@@ -15,7 +15,8 @@ use std::ptr::NonNull;
 #[cfg_attr(not(target_os = "linux"), allow(dead_code))]
 const HUGE_PAGE: usize = 2 << 20;
 
-/// A fixed-length array of `T`, page-aligned and on huge pages from [`HUGE_PAGE`] bytes up.
+/// A fixed-length array of `T`; from [`HUGE_PAGE`] bytes up, in a mapping of its own that
+/// starts on a huge page and asks for them.
 pub struct LargeArray<T: Copy> {
     ptr: NonNull<T>,
     len: usize,
@@ -86,11 +87,7 @@ impl<T: Copy> LargeArray<T> {
         // advised now, they are huge pages when first written. The advice is only a hint,
         // so its failure (a kernel without transparent huge pages) is no error.
         unsafe {
-            libc::madvise(
-                start as *mut libc::c_void,
-                size.next_multiple_of(4096),
-                libc::MADV_HUGEPAGE,
-            );
+            libc::madvise(start as *mut libc::c_void, size, libc::MADV_HUGEPAGE);
             std::ptr::copy_nonoverlapping(items.as_ptr(), start, items.len());
         }
         Some(LargeArray {

@@ -632,8 +632,9 @@ impl TriangleMesh {
         if inside != 0 {
             // Is t conservatively positive? pbrt-v4's bound δt (§6.8.4, in f32) takes a
             // division and some forty operations. With M the largest sheared coordinate,
-            // δt·|det| ≤ 3(4γ₃ + 10γ₅)M³ < 42γ₅M³, and t·|det| = |t_scaled|: that settles
-            // nearly every hit but one near the ray's origin, which gets the full bound.
+            // δt·|det| ≤ 3(4γ₃ + 10γ₅)M³ < 42γ₅M³ (48 leaves room for f32's roundings), and
+            // t·|det| = |t_scaled|: that settles nearly every hit but one near the ray's
+            // origin, which gets the full bound.
             let max3 = |p: V, q: V, s: V| p.abs().max(q.abs()).max(s.abs());
             let max_z = max3(az, bz, cz);
             let max_x = max3(a[0], b[0], c[0]);
