@@ -392,7 +392,7 @@ impl Bvh {
             return unsafe { self.traverse_avx::<NEAREST_FIRST, STRIDE>(ray, t_max, items, visit) };
         }
         let r = BoxRay::new(ray);
-        self.traverse_with::<NEAREST_FIRST, STRIDE, true>(t_max, items, visit, |planes, far| {
+        self.traverse_with::<NEAREST_FIRST, STRIDE>(t_max, items, visit, |planes, far| {
             r.test8(planes, F4::splat(far))
         });
     }
@@ -412,21 +412,15 @@ impl Bvh {
     ) {
         // SAFETY: this function runs only where the CPU has AVX and FMA.
         let wide = unsafe { BoxRayAvx::new(ray) };
-        // An unused slot's box is inverted (+∞ to -∞), which this test never finds crossed:
-        // it needs no slot mask, whose load and `and` would lengthen each node visit.
-        self.traverse_with::<NEAREST_FIRST, STRIDE, false>(
-            t_max,
-            items,
-            visit,
-            |planes, far| unsafe { wide.test8(planes, far) },
-        );
+        self.traverse_with::<NEAREST_FIRST, STRIDE>(t_max, items, visit, |planes, far| unsafe {
+            wide.test8(planes, far)
+        });
     }
 
     /// The traversal, with `test(planes, far)` giving a node's eight entry distances and
-    /// the mask of the children the ray crosses before `far`, of which only the used slots
-    /// count if `SLOT_MASK`.
+    /// the mask of the children the ray crosses before `far`.
     #[inline(always)]
-    fn traverse_with<const NEAREST_FIRST: bool, const STRIDE: usize, const SLOT_MASK: bool>(
+    fn traverse_with<const NEAREST_FIRST: bool, const STRIDE: usize>(
         &self,
         t_max: f64,
         items: LeafItems<STRIDE>,
@@ -464,8 +458,7 @@ impl Bvh {
                 };
                 let (near, hits) = test(&node.planes, far);
                 // Eight lanes: indices below stay under eight.
-                let mut hits = if SLOT_MASK { hits & node.used } else { hits } & 0xFF;
-                debug_assert_eq!(hits & !node.used, 0, "an unused slot crossed");
+                let mut hits = hits & node.used & 0xFF;
                 if hits != 0 {
                     let first = hits.trailing_zeros() as usize & 7;
                     hits &= hits - 1;
