@@ -158,10 +158,6 @@ const PLANE_OFFSETS: [[[usize; 3]; 2]; 8] = {
 #[cfg(target_arch = "x86_64")]
 pub struct BoxRayAvx {
     inv_dir: [std::arch::x86_64::__m256; 3],
-    /// 1/direction times [`FAR_SCALE`], for the exit distances: they come out enlarged,
-    /// so that the node test's chain of dependent operations has no multiplication after
-    /// the minimum of the exits.
-    exit_inv_dir: [std::arch::x86_64::__m256; 3],
     /// Byte offsets, within a node's planes, of the plane the ray enters each slab through
     /// and of the one it leaves through.
     entry_offset: [usize; 3],
@@ -183,14 +179,8 @@ impl BoxRayAvx {
     pub unsafe fn new(ray: &Ray) -> BoxRayAvx {
         use std::arch::x86_64::*;
         let (inv, up, down) = prepare(ray);
-        // An exit so computed (d rounded to f32, 1/d and the product with the scale
-        // rounded, the fused difference rounded; o's rounding is bracketed) is at least the
-        // exact one times (1 + 2γ₅)(1 - ε)⁴, and an entry at most the exact one times
-        // (1 + ε)³: a box the ray crosses still passes.
-        let exit_inv = inv.mul(F4::splat(FAR_SCALE));
         // o·(1/d) for each bracketing origin: the larger one never overestimates an entry
         // distance, the smaller one never underestimates an exit, whatever the sign.
-        let (exit_up, exit_down) = (up.mul(exit_inv), down.mul(exit_inv));
         let (up, down) = (up.mul(inv), down.mul(inv));
         let spread = |v: F4| {
             let v = v.raw();
@@ -205,11 +195,10 @@ impl BoxRayAvx {
         let [entry_offset, exit_offset] = PLANE_OFFSETS[inv.lt(F4::splat(0.0)) as usize & 7];
         BoxRayAvx {
             inv_dir: spread(inv),
-            exit_inv_dir: spread(exit_inv),
             entry_offset,
             exit_offset,
             entry_shift: spread(up.max(down)),
-            exit_shift: spread(exit_up.min(exit_down)),
+            exit_shift: spread(up.min(down)),
         }
     }
 
@@ -223,28 +212,22 @@ impl BoxRayAvx {
     pub unsafe fn test8(&self, planes: &[[f32; 8]; 6], far: f32) -> ([f32; 8], u32) {
         use std::arch::x86_64::*;
         let base = planes.as_ptr() as *const u8;
-        let slab = |offset: usize, inv: __m256, shift: __m256| {
+        let slab = |offset: usize, a: usize, shift: &[__m256; 3]| {
             // SAFETY: offsets name one of the six [f32; 8] rows.
             let plane = unsafe { _mm256_loadu_ps(base.add(offset) as *const f32) };
-            _mm256_fmsub_ps(plane, inv, shift)
+            _mm256_fmsub_ps(plane, self.inv_dir[a], shift[a])
         };
-        let entry = |a: usize| slab(self.entry_offset[a], self.inv_dir[a], self.entry_shift[a]);
-        let exit = |a: usize| {
-            slab(
-                self.exit_offset[a],
-                self.exit_inv_dir[a],
-                self.exit_shift[a],
-            )
-        };
+        let entry = |a: usize| slab(self.entry_offset[a], a, &self.entry_shift);
+        let exit = |a: usize| slab(self.exit_offset[a], a, &self.exit_shift);
         let near = _mm256_max_ps(
             _mm256_max_ps(entry(0), entry(1)),
             _mm256_max_ps(entry(2), _mm256_setzero_ps()),
         );
-        // The exits are enlarged already; `far` is enlarged alike, off the chain.
         let leave = _mm256_min_ps(
             _mm256_min_ps(exit(0), exit(1)),
-            _mm256_min_ps(exit(2), _mm256_set1_ps(far * FAR_SCALE)),
+            _mm256_min_ps(exit(2), _mm256_set1_ps(far)),
         );
+        let leave = _mm256_mul_ps(leave, _mm256_set1_ps(FAR_SCALE));
         let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, leave)) as u32;
         let mut out = [0.0f32; 8];
         // SAFETY: stores the 32 bytes of `out`.
