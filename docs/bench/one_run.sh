@@ -2,7 +2,8 @@
 # The acceleration figures of docs/acceleration.md in one run: every structure (Embree
 # included) on the bunny, the dragon and the level-8 icosphere, camera and incoherent rays,
 # ROUNDS times over in turn, so that the machine's drift falls on all alike. Prints the
-# table of medians and the ratios; keeps the raw JSON lines in WORK/runs.jsonl.
+# table of medians, the ratios, and the BVH against Embree round by round (how far the
+# machine moved); keeps the raw JSON lines in WORK/runs.jsonl.
 #
 #   docs/bench/one_run.sh PLENUM [WORK] [ROUNDS]
 #   cargo build --release -p plenum-cli --features embree   # needs libembree-dev
@@ -47,9 +48,11 @@ python3 - runs.jsonl <<'EOF'
 import json, statistics, sys
 from collections import defaultdict
 runs = defaultdict(list)
+rounds = defaultdict(list)
 for line in open(sys.argv[1]):
     row = json.loads(line)
     runs[row["mesh"], row["kind"], row["result"]["accel"]].append(row["result"])
+    rounds[row["mesh"], row["kind"], row["result"]["accel"]].append(row["round"])
 def median(mesh, kind, accel, field):
     return statistics.median(r[field] for r in runs[mesh, kind, accel])
 print("| mesh | structure | camera rays | incoherent rays | build | bytes/triangle | closest vs Embree (camera / incoherent) |")
@@ -73,4 +76,19 @@ for mesh in ["bunny", "dragon", "ico"]:
             o = [median(mesh, kind, other, f) for f in ["closest_mrays_per_s", "any_mrays_per_s"]]
             ratios.append(f"bvh/{other} {bvh[0] / o[0]:.2f} {bvh[1] / o[1]:.2f}")
         print(f"{mesh} {kind} (closest, any): " + " | ".join(ratios))
+# Embree and the BVH run one after the other in each round, so their ratio round by round
+# shows how far the machine moved while the table was measured.
+print()
+by_round = defaultdict(dict)
+for key, results in runs.items():
+    for r, result in zip(rounds[key], results):
+        by_round[key[0], key[1], r][key[2]] = result
+for mesh in ["bunny", "dragon", "ico"]:
+    for kind in ["primary", "incoherent"]:
+        spread = []
+        for field in ["closest_mrays_per_s", "any_mrays_per_s"]:
+            ratios = sorted(by_round[mesh, kind, r]["bvh"][field] / by_round[mesh, kind, r]["embree"][field]
+                            for r in sorted({r for (m, k, r) in by_round if (m, k) == (mesh, kind)}))
+            spread.append(f"{statistics.median(ratios):.2f} ({ratios[0]:.2f}–{ratios[-1]:.2f})")
+        print(f"{mesh} {kind} bvh/embree round by round, median (least–most): closest {spread[0]}, any {spread[1]}")
 EOF
