@@ -13,7 +13,7 @@
 # camera rays, 10⁶ incoherent rays); a round takes about a minute and a half on 2 cores.
 set -euo pipefail
 if [ $# -lt 1 ]; then
-  sed -n '2,12p' "$0" >&2
+  sed -n '2,13p' "$0" >&2
   exit 2
 fi
 plenum=$(realpath "$1") work=${2:-/tmp/one-run} rounds=${3:-5}
