@@ -604,9 +604,7 @@ impl TriangleMesh {
             sheared::<V>(isa, blocks, 1, [kx, ky, KZ], origin, shear),
             sheared::<V>(isa, blocks, 2, [kx, ky, KZ], origin, shear),
         );
-        let e0 = b[0].mul(c[1]).sub(b[1].mul(c[0]));
-        let e1 = c[0].mul(a[1]).sub(c[1].mul(a[0]));
-        let e2 = a[0].mul(b[1]).sub(a[1].mul(b[0]));
+        let [e0, e1, e2] = edge_functions(a, b, c);
         let zero = splat(0.0);
         // All three of one sign: the least not below zero, or the greatest not above. A
         // padding lane's NaNs pass neither comparison.
@@ -632,11 +630,10 @@ impl TriangleMesh {
         if inside != 0 {
             // Is t conservatively positive? pbrt-v4's bound (§6.8.4) takes a division and
             // some forty operations; a cheaper one settles nearly every hit first.
-            let max3 = |p: V, q: V, s: V| p.abs().max(q.abs()).max(s.abs());
             let extent = [
-                max3(a[0], b[0], c[0]),
-                max3(a[1], b[1], c[1]),
-                max3(az, bz, cz),
+                max_abs(a[0], b[0], c[0]),
+                max_abs(a[1], b[1], c[1]),
+                max_abs(az, bz, cz),
             ];
             let settled = clear_of_origin_cheaply(isa, extent, t_scaled);
             if inside & !settled != 0 {
@@ -722,6 +719,23 @@ impl TriangleMesh {
     }
 }
 
+/// The edge functions of the watertight test, of the sheared corners `a`, `b`, `c` (x, y):
+/// for each edge, twice the signed area of the triangle it makes with the ray's axis.
+#[inline(always)]
+fn edge_functions<V: Lanes>(a: [V; 3], b: [V; 3], c: [V; 3]) -> [V; 3] {
+    [
+        b[0].mul(c[1]).sub(b[1].mul(c[0])),
+        c[0].mul(a[1]).sub(c[1].mul(a[0])),
+        a[0].mul(b[1]).sub(a[1].mul(b[0])),
+    ]
+}
+
+/// The largest magnitude of three, lane by lane.
+#[inline(always)]
+fn max_abs<V: Lanes>(p: V, q: V, s: V) -> V {
+    p.abs().max(q.abs()).max(s.abs())
+}
+
 /// The lanes whose hit distance is surely above pbrt-v4's conservative bound δt (§6.8.4),
 /// found without its division. `extent` holds the largest |coordinate| of the sheared
 /// corners on x, y and z (X, Y, Z), `t_scaled` the distance times the determinant.
@@ -763,7 +777,7 @@ fn beyond_error_bound<V: Lanes>(isa: V::Isa, extent: [V; 3], e: [V; 3], det: V, 
         .add(delta_y.mul(max_x))
         .add(delta_x.mul(max_y))
         .mul(splat(2.0));
-    let max_e = e[0].abs().max(e[1].abs()).max(e[2].abs());
+    let max_e = max_abs(e[0], e[1], e[2]);
     let delta_t = max_e
         .mul(max_z)
         .mul(splat(gamma_f32(3)))
@@ -1197,14 +1211,11 @@ mod tests {
                 }
             }
             let [a, b, c] = corners.map(|corner| corner.map(F4::from_array));
-            let e0 = b[0].mul(c[1]).sub(b[1].mul(c[0]));
-            let e1 = c[0].mul(a[1]).sub(c[1].mul(a[0]));
-            let e2 = a[0].mul(b[1]).sub(a[1].mul(b[0]));
+            let [e0, e1, e2] = edge_functions(a, b, c);
             let det = e0.add(e1).add(e2);
             let t_scaled = e0.mul(a[2]).add(e1.mul(b[2])).add(e2.mul(c[2]));
             let t = t_scaled.div(det);
-            let max3 = |p: F4, q: F4, s: F4| p.abs().max(q.abs()).max(s.abs());
-            let extent = [0, 1, 2].map(|axis| max3(a[axis], b[axis], c[axis]));
+            let extent = [0, 1, 2].map(|axis| max_abs(a[axis], b[axis], c[axis]));
             let zero = F4::splat(0.0);
             let positive = zero.lt(t) & !det.eq(zero);
             let settled = clear_of_origin_cheaply((), extent, t_scaled) & positive;
