@@ -8,15 +8,20 @@
 #   docs/bench/one_run.sh PLENUM [WORK] [ROUNDS]
 #   cargo build --release -p plenum-cli --features embree   # needs libembree-dev
 #   docs/bench/one_run.sh target/release/plenum /tmp/one-run 5
+#   THREADS=1 ACCELS="embree bvh" docs/bench/one_run.sh target/release/plenum  # one thread
+# (ACCELS must name embree and bvh; THREADS is passed to `plenum bench --threads`.)
 #
 # Rays and the icosphere are made in WORK the first time (make_rays.py defaults: 1024²
 # camera rays, 10⁶ incoherent rays); a round takes about a minute and a half on 2 cores.
 set -euo pipefail
 if [ $# -lt 1 ]; then
-  sed -n '2,13p' "$0" >&2
+  sed -n '2,15p' "$0" >&2
   exit 2
 fi
 plenum=$(realpath "$1") work=${2:-/tmp/one-run} rounds=${3:-5}
+accels=${ACCELS:-embree bvh grid octree}
+threads=()
+[ -n "${THREADS:-}" ] && threads=(--threads "$THREADS")
 here=$(dirname "$(realpath "$0")")
 shared=$(realpath "$here/../../../shared")
 mkdir -p "$work"
@@ -37,8 +42,9 @@ done
 for round in $(seq "$rounds"); do
   for name in bunny dragon ico; do
     for kind in primary incoherent; do
-      for accel in embree bvh grid octree; do
-        result=$("$plenum" bench --mesh "${meshes[$name]}" --rays "$name-$kind.rays" --accel $accel --json)
+      for accel in $accels; do
+        result=$("$plenum" bench --mesh "${meshes[$name]}" --rays "$name-$kind.rays" --accel $accel \
+          "${threads[@]}" --json)
         echo "{\"round\":$round,\"mesh\":\"$name\",\"kind\":\"$kind\",\"result\":$result}" >> runs.jsonl
       done
     done
@@ -53,12 +59,13 @@ for line in open(sys.argv[1]):
     row = json.loads(line)
     runs[row["mesh"], row["kind"], row["result"]["accel"]].append(row["result"])
     rounds[row["mesh"], row["kind"], row["result"]["accel"]].append(row["round"])
+accels = [a for a in ["embree", "bvh", "grid", "octree"] if any(k[2] == a for k in runs)]
 def median(mesh, kind, accel, field):
     return statistics.median(r[field] for r in runs[mesh, kind, accel])
 print("| mesh | structure | camera rays | incoherent rays | build | bytes/triangle | closest vs Embree (camera / incoherent) |")
 print("|---|---|---|---|---|---|---|")
 for mesh in ["bunny", "dragon", "ico"]:
-    for accel in ["embree", "bvh", "grid", "octree"]:
+    for accel in accels:
         cells = [f"{median(mesh, k, accel, 'closest_mrays_per_s'):.1f} / "
                  f"{median(mesh, k, accel, 'any_mrays_per_s'):.1f}" for k in ["primary", "incoherent"]]
         both = runs[mesh, "primary", accel] + runs[mesh, "incoherent", accel]
@@ -72,7 +79,7 @@ for mesh in ["bunny", "dragon", "ico"]:
     for kind in ["primary", "incoherent"]:
         bvh = [median(mesh, kind, "bvh", f) for f in ["closest_mrays_per_s", "any_mrays_per_s"]]
         ratios = []
-        for other in ["embree", "grid", "octree"]:
+        for other in [a for a in accels if a != "bvh"]:
             o = [median(mesh, kind, other, f) for f in ["closest_mrays_per_s", "any_mrays_per_s"]]
             ratios.append(f"bvh/{other} {bvh[0] / o[0]:.2f} {bvh[1] / o[1]:.2f}")
         print(f"{mesh} {kind} (closest, any): " + " | ".join(ratios))
