@@ -1,6 +1,8 @@
 //! `plenum bench`: an acceleration structure measured on exactly the rays another
 //! intersector traces (../shared/bench): build time and memory, then closest-hit and any-hit
-//! throughput, the median of several passes after a warm-up.
+//! throughput, the median of several passes after a warm-up. With `--baseline`, a second
+//! structure is measured in the same process, its passes taking turns with the first's, and
+//! the two compared pass by pass and hit by hit.
 
 use clap::Args;
 use plenum_core::accel::AccelKind;
@@ -34,6 +36,11 @@ pub struct BenchArgs {
     /// Timed passes per query, after one warm-up pass.
     #[arg(long, default_value_t = 5)]
     passes: usize,
+    /// A second structure to measure in turn with `--accel`, pass for pass, reporting the
+    /// ratio of their speeds in each pair of passes: a machine whose speed drifts between
+    /// runs of a few seconds then slows both alike.
+    #[arg(long)]
+    baseline: Option<BenchAccel>,
     /// Print JSON instead of text.
     #[arg(long)]
     json: bool,
@@ -120,8 +127,10 @@ impl Target {
     }
 }
 
-/// A file ray as Plenum traces it: the interval [t_min, t_max] becomes (0, t_max − t_min)
-/// from the point at t_min, since Plenum's rays start where they are valid.
+/// A file ray as Plenum traces it: the interval [t_min, t_max] becomes (0, t_max − t_min]
+/// from the point at t_min, since Plenum's rays start where they are valid. Plenum's
+/// queries leave out their far end, so they are given the next f64 above it (a hit exactly
+/// at t_max counts, as the format and Embree have it).
 struct Prepared {
     ray: Ray,
     t_min: f64,
@@ -139,7 +148,7 @@ fn prepare(r: &FileRay) -> Prepared {
     Prepared {
         ray: Ray::new(o + d * t_min, d),
         t_min,
-        t_max: r.t_max as f64 - t_min,
+        t_max: (r.t_max as f64 - t_min).next_up(),
     }
 }
 
@@ -165,69 +174,83 @@ pub fn run(args: BenchArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let is_mesh = matches!(extension(&args.mesh).as_str(), "obj" | "ply");
-    // Load, then time the build of the chosen structure alone.
-    let (target, build_seconds) = pool
-        .install(|| {
-            let kind = match args.accel {
-                BenchAccel::Plenum(kind) => kind,
-                BenchAccel::Embree => return embree_target(&args.mesh, is_mesh),
-            };
-            if is_mesh {
-                let mut mesh = plenum_scene::load_mesh(&args.mesh)?;
-                let start = Instant::now();
-                mesh.set_accel(kind);
-                Ok((Target::Mesh(Box::new(mesh)), start.elapsed().as_secs_f64()))
-            } else {
-                let scene = plenum_scene::load_scene(&args.mesh)?.scene;
-                let start = Instant::now();
-                let scene = scene.with_accel(kind);
-                Ok((
-                    Target::Scene(Box::new(scene)),
-                    start.elapsed().as_secs_f64(),
-                ))
-            }
-        })
-        .unwrap_or_else(|e: plenum_scene::SceneError| {
-            eprintln!("{e}");
-            std::process::exit(2)
-        });
+    let build = |accel: BenchAccel| {
+        pool.install(|| build_target(accel, &args.mesh))
+            .unwrap_or_else(|e: plenum_scene::SceneError| {
+                eprintln!("{e}");
+                std::process::exit(2)
+            })
+    };
+    let (target, build_seconds) = build(args.accel);
+    let baseline = args.baseline.map(|accel| (accel, build(accel)));
     let rays: Vec<Prepared> = file_rays.iter().map(prepare).collect();
     let threads = pool.current_num_threads();
+    let closest_pass =
+        |target: &Target, hits: &mut [FileHit]| pool.install(|| trace_closest(target, &rays, hits));
+    let any_pass = |target: &Target| pool.install(|| count_occluded(target, &rays));
 
     let mut hits = vec![FileHit::MISS; rays.len()];
-    let closest_pass = |hits: &mut [FileHit]| {
-        pool.install(|| {
-            hits.par_chunks_mut(1024)
-                .zip(rays.par_chunks(1024))
-                .for_each(|(out, rays)| {
-                    for (h, r) in out.iter_mut().zip(rays) {
-                        *h = match target.closest(&r.ray, r.t_max) {
-                            Some((t, prim)) => FileHit {
-                                t: (t + r.t_min) as f32,
-                                prim,
-                            },
-                            None => FileHit::MISS,
-                        };
-                    }
-                })
-        })
-    };
-    let any_pass = || {
-        pool.install(|| {
-            rays.par_chunks(1024)
-                .map(|rays| {
-                    rays.iter()
-                        .filter(|r| target.occluded(&r.ray, r.t_max))
-                        .count()
-                })
-                .sum::<usize>()
-        })
-    };
-    let closest_seconds = median_time(args.passes, || closest_pass(&mut hits));
-    let hit_count = hits.iter().filter(|h| h.prim != u32::MAX).count();
     let mut occluded = 0;
-    let any_seconds = median_time(args.passes, || occluded = any_pass());
+    let mut base_hits = vec![FileHit::MISS; if baseline.is_some() { rays.len() } else { 0 }];
+    let mut base_occluded = 0;
+    let (times, base_times) = match &baseline {
+        None => (
+            Times {
+                closest: timed_passes(args.passes, || closest_pass(&target, &mut hits)),
+                any: timed_passes(args.passes, || occluded = any_pass(&target)),
+            },
+            None,
+        ),
+        Some((_, (base, _))) => {
+            let (closest, base_closest) = timed_in_turn(
+                args.passes,
+                || closest_pass(&target, &mut hits),
+                || closest_pass(base, &mut base_hits),
+            );
+            let (any, base_any) = timed_in_turn(
+                args.passes,
+                || occluded = any_pass(&target),
+                || base_occluded = any_pass(base),
+            );
+            let base_times = Times {
+                closest: base_closest,
+                any: base_any,
+            };
+            (Times { closest, any }, Some(base_times))
+        }
+    };
+    let geometry = args.mesh.display().to_string();
+    let measured = Measured {
+        accel: args.accel,
+        target: &target,
+        build_seconds,
+        times,
+        hits: &hits,
+        occluded,
+    };
+    let against = baseline
+        .as_ref()
+        .zip(base_times)
+        .map(|((accel, (base, seconds)), times)| {
+            let base = Measured {
+                accel: *accel,
+                target: base,
+                build_seconds: *seconds,
+                times,
+                hits: &base_hits,
+                occluded: base_occluded,
+            };
+            Against {
+                closest: Spread::of_ratios(&base.times.closest, &measured.times.closest),
+                any: Spread::of_ratios(&base.times.any, &measured.times.any),
+                agreeing_hits: agreeing_hits(&hits, &base_hits),
+                baseline: base.report(&geometry, threads),
+            }
+        });
+    let output = Output {
+        report: measured.report(&geometry, threads),
+        against,
+    };
 
     if let Some(path) = &args.hits_out {
         if let Err(e) = write_hits(path, &hits) {
@@ -235,32 +258,80 @@ pub fn run(args: BenchArgs) -> ExitCode {
             return ExitCode::from(1);
         }
     }
-    let n = rays.len().max(1) as f64;
-    let prims = target.primitive_count();
-    let memory = target.memory_bytes();
-    let report = Report {
-        geometry: args.mesh.display().to_string(),
-        primitives: prims,
-        accel: args.accel.name(),
-        threads,
-        build_ms: build_seconds * 1e3,
-        build_mprims_per_s: prims as f64 / build_seconds.max(1e-12) / 1e6,
-        memory_bytes: memory,
-        bytes_per_primitive: memory as f64 / prims.max(1) as f64,
-        rays: rays.len(),
-        closest_mrays_per_s: n / closest_seconds.max(1e-12) / 1e6,
-        closest_ms: closest_seconds * 1e3,
-        hit_fraction: hit_count as f64 / n,
-        any_mrays_per_s: n / any_seconds.max(1e-12) / 1e6,
-        any_ms: any_seconds * 1e3,
-        occluded_fraction: occluded as f64 / n,
-    };
     if args.json {
-        println!("{}", report.json());
+        println!("{}", output.json());
     } else {
-        report.print(&args.rays, args.passes);
+        output.print(&args.rays, args.passes);
     }
     ExitCode::SUCCESS
+}
+
+/// Loads the geometry and builds `accel` over it: the structure, and the build's seconds
+/// (the build alone, not the loading).
+fn build_target(accel: BenchAccel, path: &Path) -> Result<(Target, f64), plenum_scene::SceneError> {
+    let is_mesh = matches!(extension(path).as_str(), "obj" | "ply");
+    let kind = match accel {
+        BenchAccel::Plenum(kind) => kind,
+        BenchAccel::Embree => return embree_target(path, is_mesh),
+    };
+    if is_mesh {
+        let mut mesh = plenum_scene::load_mesh(path)?;
+        let start = Instant::now();
+        mesh.set_accel(kind);
+        Ok((Target::Mesh(Box::new(mesh)), start.elapsed().as_secs_f64()))
+    } else {
+        let scene = plenum_scene::load_scene(path)?.scene;
+        let start = Instant::now();
+        let scene = scene.with_accel(kind);
+        Ok((
+            Target::Scene(Box::new(scene)),
+            start.elapsed().as_secs_f64(),
+        ))
+    }
+}
+
+/// Every ray's closest hit, into `hits`, in chunks across the pool's threads.
+fn trace_closest(target: &Target, rays: &[Prepared], hits: &mut [FileHit]) {
+    hits.par_chunks_mut(1024)
+        .zip(rays.par_chunks(1024))
+        .for_each(|(out, rays)| {
+            for (h, r) in out.iter_mut().zip(rays) {
+                *h = match target.closest(&r.ray, r.t_max) {
+                    Some((t, prim)) => FileHit {
+                        t: (t + r.t_min) as f32,
+                        prim,
+                    },
+                    None => FileHit::MISS,
+                };
+            }
+        })
+}
+
+/// How many rays are blocked, by any-hit queries across the pool's threads.
+fn count_occluded(target: &Target, rays: &[Prepared]) -> usize {
+    rays.par_chunks(1024)
+        .map(|rays| {
+            rays.iter()
+                .filter(|r| target.occluded(&r.ray, r.t_max))
+                .count()
+        })
+        .sum()
+}
+
+/// Rays whose closest hits agree: both miss, or both hit the same primitive or at distances
+/// within 10⁻⁴ of each other relatively (a ray through a shared edge may report either
+/// triangle; ../shared/bench/check_hits.py accepts the same).
+fn agreeing_hits(a: &[FileHit], b: &[FileHit]) -> usize {
+    a.iter()
+        .zip(b)
+        .filter(|(a, b)| {
+            let (a_hit, b_hit) = (a.prim != u32::MAX, b.prim != u32::MAX);
+            a_hit == b_hit
+                && (!a_hit
+                    || a.prim == b.prim
+                    || (a.t - b.t).abs() <= 1e-4 * a.t.abs().max(b.t.abs()))
+        })
+        .count()
 }
 
 /// Embree's structure over a mesh file's triangles, and its build time.
@@ -295,18 +366,167 @@ fn extension(path: &Path) -> String {
         .to_ascii_lowercase()
 }
 
-/// One warm-up run, then the median time of `passes` runs.
-fn median_time(passes: usize, mut f: impl FnMut()) -> f64 {
+/// One structure's build and passes, and what its last passes found.
+struct Measured<'a> {
+    accel: BenchAccel,
+    target: &'a Target,
+    build_seconds: f64,
+    times: Times,
+    hits: &'a [FileHit],
+    occluded: usize,
+}
+
+impl Measured<'_> {
+    fn report(&self, geometry: &str, threads: usize) -> Report {
+        let n = self.hits.len().max(1) as f64;
+        let prims = self.target.primitive_count();
+        let memory = self.target.memory_bytes();
+        let (closest, any) = (median(&self.times.closest), median(&self.times.any));
+        Report {
+            geometry: geometry.to_string(),
+            primitives: prims,
+            accel: self.accel.name(),
+            threads,
+            build_ms: self.build_seconds * 1e3,
+            build_mprims_per_s: prims as f64 / self.build_seconds.max(1e-12) / 1e6,
+            memory_bytes: memory,
+            bytes_per_primitive: memory as f64 / prims.max(1) as f64,
+            rays: self.hits.len(),
+            closest_mrays_per_s: n / closest.max(1e-12) / 1e6,
+            closest_ms: closest * 1e3,
+            hit_fraction: self.hits.iter().filter(|h| h.prim != u32::MAX).count() as f64 / n,
+            any_mrays_per_s: n / any.max(1e-12) / 1e6,
+            any_ms: any * 1e3,
+            occluded_fraction: self.occluded as f64 / n,
+        }
+    }
+}
+
+/// The seconds of each timed pass, per query.
+struct Times {
+    closest: Vec<f64>,
+    any: Vec<f64>,
+}
+
+/// One warm-up run, then the seconds of each of `passes` runs.
+fn timed_passes(passes: usize, mut f: impl FnMut()) -> Vec<f64> {
     f();
-    let mut times: Vec<f64> = (0..passes)
-        .map(|_| {
-            let start = Instant::now();
-            f();
-            start.elapsed().as_secs_f64()
+    (0..passes).map(|_| seconds(&mut f)).collect()
+}
+
+/// `a` and `b` in turn: a warm-up run of each, then `passes` runs of each, which of the two
+/// goes first swapped every pass. The seconds of each run, `a`'s and `b`'s.
+fn timed_in_turn(passes: usize, mut a: impl FnMut(), mut b: impl FnMut()) -> (Vec<f64>, Vec<f64>) {
+    a();
+    b();
+    (0..passes)
+        .map(|pass| {
+            if pass % 2 == 0 {
+                let ta = seconds(&mut a);
+                (ta, seconds(&mut b))
+            } else {
+                let tb = seconds(&mut b);
+                (seconds(&mut a), tb)
+            }
         })
-        .collect();
-    times.sort_by(f64::total_cmp);
-    times[times.len() / 2]
+        .unzip()
+}
+
+fn seconds(f: &mut impl FnMut()) -> f64 {
+    let start = Instant::now();
+    f();
+    start.elapsed().as_secs_f64()
+}
+
+fn median(values: &[f64]) -> f64 {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    sorted[sorted.len() / 2]
+}
+
+/// The median, least and greatest of some numbers.
+#[derive(Clone, Copy)]
+struct Spread {
+    median: f64,
+    least: f64,
+    most: f64,
+}
+
+impl Spread {
+    /// Of `numerators[i] / denominators[i]`: for times of a baseline over the same pass's
+    /// times of the structure measured, how many times as fast the structure was.
+    fn of_ratios(numerators: &[f64], denominators: &[f64]) -> Spread {
+        let ratios: Vec<f64> = numerators
+            .iter()
+            .zip(denominators)
+            .map(|(n, d)| n / d.max(1e-12))
+            .collect();
+        Spread {
+            median: median(&ratios),
+            least: ratios.iter().copied().fold(f64::INFINITY, f64::min),
+            most: ratios.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        }
+    }
+
+    fn json(&self) -> serde_json::Value {
+        serde_json::json!({ "median": self.median, "least": self.least, "most": self.most })
+    }
+}
+
+/// The measured structure against `--baseline`, measured in turn with it.
+struct Against {
+    /// How many times as fast as the baseline, pass by pass.
+    closest: Spread,
+    any: Spread,
+    /// Rays whose closest hits agree with the baseline's (see [`agreeing_hits`]).
+    agreeing_hits: usize,
+    baseline: Report,
+}
+
+struct Output {
+    report: Report,
+    against: Option<Against>,
+}
+
+impl Output {
+    fn json(&self) -> String {
+        let mut json = self.report.json();
+        if let Some(against) = &self.against {
+            json["baseline"] = serde_json::json!({
+                "report": against.baseline.json(),
+                "closest_speedup": against.closest.json(),
+                "any_speedup": against.any.json(),
+                "agreeing_hits": against.agreeing_hits,
+            });
+        }
+        json.to_string()
+    }
+
+    fn print(&self, rays: &Path, passes: usize) {
+        self.report.print(rays, passes);
+        if let Some(against) = &self.against {
+            let b = &against.baseline;
+            println!();
+            println!(
+                "baseline {}, its passes in turn with {}'s:",
+                b.accel, self.report.accel
+            );
+            b.print_build();
+            b.print_speeds();
+            let ratio = |s: &Spread| format!("{:.2}× ({:.2}–{:.2})", s.median, s.least, s.most);
+            println!(
+                "{} against {}, pass by pass, median (least–most): closest hit {}, any hit {}",
+                self.report.accel,
+                b.accel,
+                ratio(&against.closest),
+                ratio(&against.any)
+            );
+            println!(
+                "closest hits agreeing: {} of {} rays",
+                against.agreeing_hits, self.report.rays
+            );
+        }
+    }
 }
 
 struct Report {
@@ -328,7 +548,7 @@ struct Report {
 }
 
 impl Report {
-    fn json(&self) -> String {
+    fn json(&self) -> serde_json::Value {
         serde_json::json!({
             "geometry": self.geometry,
             "primitives": self.primitives,
@@ -346,7 +566,6 @@ impl Report {
             "any_ms": self.any_ms,
             "occluded_fraction": self.occluded_fraction,
         })
-        .to_string()
     }
 
     fn print(&self, rays: &Path, passes: usize) {
@@ -354,18 +573,32 @@ impl Report {
             "{}: {} primitives, {} on {} threads",
             self.geometry, self.primitives, self.accel, self.threads
         );
-        println!(
-            "build: {:.1} ms ({:.2} Mprims/s); {:.1} bytes per primitive ({:.1} MB with vertices and indices)",
-            self.build_ms,
-            self.build_mprims_per_s,
-            self.bytes_per_primitive,
-            self.memory_bytes as f64 / 1e6
-        );
+        self.print_build();
         println!(
             "{} rays from {} (median of {passes} passes after a warm-up)",
             self.rays,
             rays.display()
         );
+        self.print_speeds();
+    }
+
+    fn print_build(&self) {
+        let memory = if self.memory_bytes == 0 {
+            "memory not reported".to_string()
+        } else {
+            format!(
+                "{:.1} bytes per primitive ({:.1} MB with vertices and indices)",
+                self.bytes_per_primitive,
+                self.memory_bytes as f64 / 1e6
+            )
+        };
+        println!(
+            "build: {:.1} ms ({:.2} Mprims/s); {memory}",
+            self.build_ms, self.build_mprims_per_s
+        );
+    }
+
+    fn print_speeds(&self) {
         println!(
             "closest hit: {:.2} Mrays/s ({:.1} ms), {:.1} % hit",
             self.closest_mrays_per_s,

@@ -327,3 +327,136 @@ fn convert_writes_a_native_scene_that_renders() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// A rays file (PLRAYS1, ../shared/bench/README.md): origin, t_min, direction, t_max each.
+fn write_rays(path: &Path, rays: &[[f32; 8]]) {
+    let mut bytes = b"PLRAYS1\0".to_vec();
+    bytes.extend((rays.len() as u64).to_le_bytes());
+    for value in rays.iter().flatten() {
+        bytes.extend(value.to_le_bytes());
+    }
+    std::fs::write(path, bytes).unwrap();
+}
+
+#[test]
+fn bench_traces_the_rays_and_compares_with_a_baseline() {
+    let tmp = temp_dir("bench");
+    let dir = tmp.path();
+    // The unit square at z = 0 as two triangles, split along y = x.
+    let mesh = write(
+        dir,
+        "square.obj",
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n",
+    );
+    // Rays straight down from z = 2 on a 10 × 10 lattice over [-0.45, 1.35]², off the
+    // diagonal: those over the square hit it at t = 2, the lower triangle where y < x.
+    let mut rays = Vec::new();
+    let mut expected = Vec::new();
+    for i in 0..10 {
+        for j in 0..10 {
+            let (x, y) = (-0.45 + 0.2 * i as f32, -0.45 + 0.2 * j as f32 + 0.01);
+            rays.push([x, y, 2.0, 0.0, 0.0, 0.0, -1.0, f32::INFINITY]);
+            let inside = (0.0..1.0).contains(&x) && (0.0..1.0).contains(&y);
+            expected.push(inside.then_some(if y < x { 0u32 } else { 1 }));
+        }
+    }
+    let rays_path = dir.join("down.rays");
+    write_rays(&rays_path, &rays);
+    let hits_path = dir.join("down.hits");
+    let o = plenum()
+        .arg("bench")
+        .arg("--mesh")
+        .arg(&mesh)
+        .arg("--rays")
+        .arg(&rays_path)
+        .args([
+            "--accel",
+            "grid",
+            "--baseline",
+            "none",
+            "--passes",
+            "3",
+            "--threads",
+            "2",
+        ])
+        .arg("--hits-out")
+        .arg(&hits_path)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let hit_count = expected.iter().filter(|e| e.is_some()).count();
+    assert_eq!(hit_count, 25);
+    assert_eq!(report["accel"], "grid");
+    assert_eq!(report["primitives"], 2);
+    assert_eq!(report["rays"], 100);
+    assert_eq!(report["hit_fraction"], 0.25);
+    assert_eq!(report["occluded_fraction"], 0.25);
+    let baseline = &report["baseline"];
+    assert_eq!(baseline["report"]["accel"], "none");
+    assert_eq!(baseline["report"]["hit_fraction"], 0.25);
+    assert_eq!(baseline["agreeing_hits"], 100);
+    for query in ["closest_speedup", "any_speedup"] {
+        let spread = &baseline[query];
+        let [least, median, most] =
+            ["least", "median", "most"].map(|k| spread[k].as_f64().unwrap());
+        assert!(0.0 < least && least <= median && median <= most, "{spread}");
+    }
+    // The hits file: the closest hit of every ray, in order.
+    let bytes = std::fs::read(&hits_path).unwrap();
+    assert_eq!(&bytes[..8], b"PLHITS1\0");
+    assert_eq!(u64::from_le_bytes(bytes[8..16].try_into().unwrap()), 100);
+    for (k, want) in expected.iter().enumerate() {
+        let record = &bytes[16 + 8 * k..24 + 8 * k];
+        let t = f32::from_le_bytes(record[..4].try_into().unwrap());
+        let prim = u32::from_le_bytes(record[4..].try_into().unwrap());
+        match want {
+            Some(p) => assert_eq!((t, prim), (2.0, *p), "ray {k}"),
+            None => assert_eq!((t, prim), (f32::INFINITY, u32::MAX), "ray {k}"),
+        }
+    }
+}
+
+#[test]
+fn bench_rejects_bad_rays_files_and_arguments() {
+    let tmp = temp_dir("bench-bad");
+    let dir = tmp.path();
+    let mesh = write(dir, "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    let truncated = dir.join("short.rays");
+    write_rays(&truncated, &[[0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0, 1.0]]);
+    let bytes = std::fs::read(&truncated).unwrap();
+    std::fs::write(&truncated, &bytes[..bytes.len() - 4]).unwrap();
+    let good = dir.join("one.rays");
+    write_rays(&good, &[[0.2, 0.2, 1.0, 0.0, 0.0, 0.0, -1.0, 1.0]]);
+    let bench = |extra: &[&str], rays: &Path| {
+        plenum()
+            .arg("bench")
+            .arg("--mesh")
+            .arg(&mesh)
+            .arg("--rays")
+            .arg(rays)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = bench(&[], &truncated);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("short.rays"), "{}", stderr(&o));
+    let o = bench(&["--passes", "0"], &good);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--passes"), "{}", stderr(&o));
+    let o = bench(&["--baseline", "kd-tree"], &good);
+    assert_eq!(o.status.code(), Some(2));
+    #[cfg(not(feature = "embree"))]
+    {
+        let o = bench(&["--baseline", "embree"], &good);
+        assert_eq!(o.status.code(), Some(2));
+        assert!(stderr(&o).contains("--features embree"), "{}", stderr(&o));
+    }
+    let o = bench(&["--json"], &good);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(report["hit_fraction"], 1.0);
+    assert!(report.get("baseline").is_none());
+}
