@@ -191,7 +191,7 @@ pub fn run(args: BenchArgs) -> ExitCode {
 
     let mut hits = vec![FileHit::MISS; rays.len()];
     let mut occluded = 0;
-    let mut base_hits = vec![FileHit::MISS; if baseline.is_some() { rays.len() } else { 0 }];
+    let mut base_hits = Vec::new();
     let mut base_occluded = 0;
     let (times, base_times) = match &baseline {
         None => (
@@ -202,6 +202,7 @@ pub fn run(args: BenchArgs) -> ExitCode {
             None,
         ),
         Some((_, (base, _))) => {
+            base_hits.resize(rays.len(), FileHit::MISS);
             let (closest, base_closest) = timed_in_turn(
                 args.passes,
                 || closest_pass(&target, &mut hits),
@@ -445,7 +446,6 @@ fn median(values: &[f64]) -> f64 {
 }
 
 /// The median, least and greatest of some numbers.
-#[derive(Clone, Copy)]
 struct Spread {
     median: f64,
     least: f64,
