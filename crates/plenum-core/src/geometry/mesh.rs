@@ -5,8 +5,8 @@
 //! bounds follow pbrt-v4 §6.8.4.
 //!
 //! The corners are stored four triangles to a block, in the lanes the SIMD test loads, as
-//! Embree's precomputed leaves are: with a BVH the blocks are in its leaf order and each leaf
-//! is a run of whole blocks, read without an index. Vertex indices are kept only where
+//! Embree's precomputed leaves are: each BVH leaf is a run of whole blocks, read without an
+//! index, stored right after the node that names it. Vertex indices are kept only where
 //! something is given per vertex (normals, uvs, or data the caller keeps, such as a scene's
 //! per-vertex materials).
 
@@ -16,7 +16,7 @@ use crate::accel::ray_f32::{gamma_f32, round_up_distance};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::simd::F8;
 use crate::accel::simd::{Avx, Lanes, F4};
-use crate::accel::{Accel, AccelKind, LeafItems, LeafSize, PAD};
+use crate::accel::{Accel, AccelKind, LeafItems, LeafSize, EMBED_UNIT, PAD};
 use crate::math::{gamma, Bounds3, Ray, Vec3};
 use std::ops::Range;
 
@@ -29,24 +29,33 @@ const LEAF: LeafSize = LeafSize {
 /// Triangles per block.
 const LANES: usize = 4;
 
-/// Four triangles' corners in f32, `[corner][axis][lane]`: the lanes the SIMD test loads.
+/// Four triangles' corners in f32, `[corner][axis][lane]`: the lanes the SIMD test loads;
+/// and where each lane's triangle was in the list the mesh was made from, or [`PAD`].
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(16))]
-struct Block([[[f32; LANES]; 3]; 3]);
+struct Block {
+    corners: [[[f32; LANES]; 3]; 3],
+    source: [u32; LANES],
+}
+
+/// A block's size in the units in which its place is counted: a stored triangle, a *part*
+/// ([`HitRecord::part`]), is its block's place (its offset from the first block's place, in
+/// [`EMBED_UNIT`]s) times [`LANES`] plus its lane.
+const BLOCK_UNITS: usize = std::mem::size_of::<Block>() / EMBED_UNIT;
 
 /// A triangle's corners in f32, `[corner][axis]`.
 type Corners = [[f32; 3]; 3];
 
 #[derive(Clone, Debug)]
 pub struct TriangleMesh {
-    /// The triangles' corners, slot `s` in lane `s % 4` of block `s / 4`, in the
-    /// structure's order: the mesh's only copy of its positions (shading widens them to
-    /// f64, exactly). A grid or an octree holds a triangle once in each of its cells.
-    /// On huge pages where there are many (see [`crate::accel::pages`]).
+    /// The triangles' corners in the structure's order, four to a block: the mesh's only
+    /// copy of its positions (shading widens them to f64, exactly). A grid or an octree
+    /// holds a triangle once in each of its cells. Empty with a BVH, which holds the blocks
+    /// among its nodes ([`crate::accel::Bvh::embed_blocks`]). On huge pages where there are
+    /// many (see [`crate::accel::pages`]).
     blocks: LargeArray<Block>,
-    /// Per slot, the triangle's position in the list the mesh was made from, or [`PAD`].
-    source: LargeArray<u32>,
-    /// Per slot, the triangle's vertex indices where `keeps_indices`; else empty.
+    /// Per triangle of the list the mesh was made from, its vertex indices where
+    /// `keeps_indices`; else empty.
     indices: Vec<[u32; 3]>,
     /// The vertex indices the mesh was made with are kept (for normals, uvs, or the caller).
     keeps_indices: bool,
@@ -174,7 +183,6 @@ impl TriangleMesh {
             .collect();
         let mut mesh = TriangleMesh {
             blocks: LargeArray::default(),
-            source: LargeArray::default(),
             indices: Vec::new(),
             keeps_indices: keep_indices,
             normals,
@@ -195,7 +203,6 @@ impl TriangleMesh {
         let (corners, indices) = self.in_source_order();
         let mut mesh = TriangleMesh {
             blocks: LargeArray::default(),
-            source: LargeArray::default(),
             indices: Vec::new(),
             normals: self.normals.clone(),
             uvs: self.uvs.clone(),
@@ -244,34 +251,37 @@ impl TriangleMesh {
             Accel::None(_) => (0..corners.len() as u32).collect(),
         };
         order.resize(order.len().next_multiple_of(LANES), PAD);
-        self.blocks = order
+        let blocks: Vec<Block> = order
             .chunks(LANES)
             .map(|slots| {
                 // A padding lane's corners are NaN: every comparison fails, so no ray hits it.
-                let mut block = Block([[[f32::NAN; LANES]; 3]; 3]);
+                let mut block = Block {
+                    corners: [[[f32::NAN; LANES]; 3]; 3],
+                    source: [PAD; LANES],
+                };
                 for (lane, &s) in slots.iter().enumerate().filter(|(_, &s)| s != PAD) {
                     for (k, corner) in corners[s as usize].iter().enumerate() {
                         for (a, &v) in corner.iter().enumerate() {
-                            block.0[k][a][lane] = v;
+                            block.corners[k][a][lane] = v;
                         }
                     }
+                    block.source[lane] = s;
                 }
                 block
             })
             .collect();
+        self.blocks = match &mut accel {
+            Accel::Bvh(bvh) => {
+                bvh.embed_blocks(&blocks, LANES);
+                LargeArray::default()
+            }
+            _ => blocks.into(),
+        };
         self.indices = if self.keeps_indices {
-            let index = |s: u32| {
-                if s == PAD {
-                    [0; 3]
-                } else {
-                    indices[s as usize]
-                }
-            };
-            order.iter().map(|&s| index(s)).collect()
+            indices.to_vec()
         } else {
             Vec::new()
         };
-        self.source = order.into();
         self.accel = accel;
     }
 
@@ -284,23 +294,16 @@ impl TriangleMesh {
         } else {
             0
         };
-        let mut indices = vec![[0; 3]; kept];
-        for (slot, &s) in self.source.iter().enumerate() {
-            if s != PAD {
-                corners[s as usize] = self.corners_f32(slot as u32);
-                if let Some(i) = indices.get_mut(s as usize) {
-                    *i = self.indices[slot];
-                }
-            }
+        for (part, s) in self.stored_parts() {
+            corners[s as usize] = self.corners_f32(part);
         }
-        (corners, indices)
+        (corners, self.indices[..kept].to_vec())
     }
 
     /// Bytes the mesh occupies: corners, indices, attributes and the acceleration structure.
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of::<TriangleMesh>()
             + self.blocks.len() * std::mem::size_of::<Block>()
-            + self.source.len() * std::mem::size_of::<u32>()
             + self.indices.len() * std::mem::size_of::<[u32; 3]>()
             + self.normals.len() * std::mem::size_of::<Vec3>()
             + self.uvs.len() * std::mem::size_of::<[f64; 2]>()
@@ -334,12 +337,52 @@ impl TriangleMesh {
     pub fn triangles(&self) -> impl Iterator<Item = (u32, [Vec3; 3])> + '_ {
         // A grid or an octree stores a triangle in each of its cells: the first stands.
         let mut seen = vec![false; self.triangle_count];
-        (0..self.source.len() as u32)
-            .filter(move |&part| {
-                let s = self.source[part as usize];
-                s != PAD && !std::mem::replace(&mut seen[s as usize], true)
-            })
-            .map(|part| (part, self.triangle(part)))
+        self.stored_parts()
+            .filter(move |&(_, s)| !std::mem::replace(&mut seen[s as usize], true))
+            .map(|(part, _)| (part, self.triangle(part)))
+    }
+
+    /// Every stored triangle (each copy, in a grid or an octree) with its position in the
+    /// list the mesh was made from.
+    fn stored_parts(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
+        let places: Vec<usize> = match &self.accel {
+            Accel::Bvh(bvh) => bvh
+                .embedded_leaves()
+                .into_iter()
+                .flat_map(|(place, count)| {
+                    (0..count.div_ceil(LANES)).map(move |b| place + b * BLOCK_UNITS)
+                })
+                .collect(),
+            _ => (0..self.blocks.len()).map(|b| b * BLOCK_UNITS).collect(),
+        };
+        places.into_iter().flat_map(move |place| {
+            let block = self.block_at(place);
+            (0..LANES)
+                .filter(move |&lane| block.source[lane] != PAD)
+                .map(move |lane| ((place * LANES + lane) as u32, block.source[lane]))
+        })
+    }
+
+    /// The stored blocks, as bytes: the BVH's nodes among them, or the blocks alone.
+    fn block_bytes(&self) -> &[u8] {
+        match &self.accel {
+            Accel::Bvh(bvh) => bvh.embedded(),
+            // SAFETY: blocks are plain data, read as the bytes they are.
+            _ => unsafe {
+                std::slice::from_raw_parts(
+                    self.blocks.as_ptr() as *const u8,
+                    std::mem::size_of_val(&*self.blocks),
+                )
+            },
+        }
+    }
+
+    /// The block at `place` (see [`BLOCK_UNITS`]). Panics if none is there.
+    fn block_at(&self, place: usize) -> &Block {
+        let bytes = &self.block_bytes()[place * EMBED_UNIT..][..std::mem::size_of::<Block>()];
+        // SAFETY: in bounds, at a multiple of EMBED_UNIT from a base aligned to a block,
+        // and any bytes are a block (plain f32 and u32).
+        unsafe { &*(bytes.as_ptr() as *const Block) }
     }
 
     /// The corners of stored triangle `part`.
@@ -349,20 +392,22 @@ impl TriangleMesh {
     }
 
     fn corners_f32(&self, part: u32) -> Corners {
-        let (block, lane) = (part as usize / LANES, part as usize % LANES);
-        let b = &self.blocks[block].0;
+        let (place, lane) = (part as usize / LANES, part as usize % LANES);
+        let b = &self.block_at(place).corners;
         [0, 1, 2].map(|k| [0, 1, 2].map(|a| b[k][a][lane]))
     }
 
     /// The vertex indices of stored triangle `part`, where the mesh keeps them (it has
     /// normals or uvs, or was made by [`TriangleMesh::new_keeping_indices`]).
     pub fn vertex_indices(&self, part: u32) -> Option<[u32; 3]> {
-        self.keeps_indices.then(|| self.indices[part as usize])
+        self.keeps_indices
+            .then(|| self.indices[self.source_triangle(part) as usize])
     }
 
     /// Where stored triangle `part` was in the list the mesh was made from.
     pub fn source_triangle(&self, part: u32) -> u32 {
-        self.source[part as usize]
+        let (place, lane) = (part as usize / LANES, part as usize % LANES);
+        self.block_at(place).source[lane]
     }
 
     /// The mesh as positions and vertex indices, the triangles in the order it was made
@@ -405,13 +450,15 @@ impl TriangleMesh {
             sheared: None,
             hit: None,
             avx,
-        };
-        let visit_run = |run: Range<usize>, t_max: &mut f64| {
-            self.search_run::<NEAREST, true>(run, t_max, &mut search)
+            blocks: self.block_bytes().as_ptr(),
         };
         match &self.accel {
             Accel::Bvh(bvh) => {
-                let items = LeafItems::<{ std::mem::size_of::<Block>() / LANES }>::at(&self.blocks);
+                // A leaf's run starts at its first block's place.
+                let visit_run = |run: Range<usize>, t_max: &mut f64| {
+                    self.search_run::<NEAREST, true>(run.start, 0..run.len(), t_max, &mut search)
+                };
+                let items = LeafItems::<EMBED_UNIT>::at(bvh.embedded());
                 if NEAREST {
                     bvh.traverse_runs(ray, t_max, items, visit_run);
                 } else {
@@ -427,8 +474,10 @@ impl TriangleMesh {
     /// their walks' state does not weigh on every BVH search.
     #[inline(never)]
     fn search_cells<const NEAREST: bool>(&self, ray: &Ray, t_max: f64, search: &mut Search) {
+        // Their runs are of slots, block after block from the first.
         let visit_run = |run: Range<usize>, t_max: &mut f64| {
-            self.search_run::<NEAREST, true>(run, t_max, search)
+            let place = run.start / LANES * BLOCK_UNITS;
+            self.search_run::<NEAREST, true>(place, 0..run.len(), t_max, search)
         };
         match &self.accel {
             Accel::Bvh(_) => unreachable!("the BVH is searched inline"),
@@ -436,8 +485,9 @@ impl TriangleMesh {
             Accel::Octree(octree) => octree.traverse_runs(ray, t_max, visit_run),
             Accel::None(brute) => brute.traverse(ray, t_max, |items, t_max| {
                 items.iter().all(|&slot| {
-                    let slot = slot as usize;
-                    self.search_run::<NEAREST, false>(slot..slot + 1, t_max, search)
+                    let (place, lane) =
+                        (slot as usize / LANES * BLOCK_UNITS, slot as usize % LANES);
+                    self.search_run::<NEAREST, false>(place, lane..lane + 1, t_max, search)
                 })
             }),
         }
@@ -452,6 +502,7 @@ impl TriangleMesh {
     #[inline(always)]
     fn search_run<const NEAREST: bool, const PADDED: bool>(
         &self,
+        place: usize,
         run: Range<usize>,
         t_max: &mut f64,
         search: &mut Search,
@@ -459,20 +510,23 @@ impl TriangleMesh {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx) = search.avx {
             // SAFETY: `avx` says the CPU has AVX.
-            return unsafe { self.search_run_avx::<NEAREST, PADDED>(avx, run, t_max, search) };
+            return unsafe {
+                self.search_run_avx::<NEAREST, PADDED>(avx, place, run, t_max, search)
+            };
         }
-        self.search_run_sse::<NEAREST, PADDED>(run, t_max, search)
+        self.search_run_sse::<NEAREST, PADDED>(place, run, t_max, search)
     }
 
     /// The leaf loop testing four triangles at a time.
     #[inline(never)]
     fn search_run_sse<const NEAREST: bool, const PADDED: bool>(
         &self,
+        place: usize,
         run: Range<usize>,
         t_max: &mut f64,
         search: &mut Search,
     ) -> bool {
-        self.search_run_with::<NEAREST, PADDED>(None, run, t_max, search)
+        self.search_run_with::<NEAREST, PADDED>(None, place, run, t_max, search)
     }
 
     /// The leaf loop testing two blocks, eight triangles, at a time where a run has them,
@@ -486,11 +540,12 @@ impl TriangleMesh {
     unsafe fn search_run_avx<const NEAREST: bool, const PADDED: bool>(
         &self,
         avx: Avx,
+        place: usize,
         run: Range<usize>,
         t_max: &mut f64,
         search: &mut Search,
     ) -> bool {
-        self.search_run_with::<NEAREST, PADDED>(Some(avx), run, t_max, search)
+        self.search_run_with::<NEAREST, PADDED>(Some(avx), place, run, t_max, search)
     }
 
     /// The leaf loop, testing blocks in pairs where `avx` is given.
@@ -498,6 +553,7 @@ impl TriangleMesh {
     fn search_run_with<const NEAREST: bool, const PADDED: bool>(
         &self,
         avx: Option<Avx>,
+        place: usize,
         run: Range<usize>,
         t_max: &mut f64,
         search: &mut Search,
@@ -509,9 +565,9 @@ impl TriangleMesh {
             None => search.ray.direction.max_abs_axis(),
         };
         match kz {
-            0 => self.search_run_along::<0, NEAREST, PADDED>(avx, run, t_max, search),
-            1 => self.search_run_along::<1, NEAREST, PADDED>(avx, run, t_max, search),
-            _ => self.search_run_along::<2, NEAREST, PADDED>(avx, run, t_max, search),
+            0 => self.search_run_along::<0, NEAREST, PADDED>(avx, place, run, t_max, search),
+            1 => self.search_run_along::<1, NEAREST, PADDED>(avx, place, run, t_max, search),
+            _ => self.search_run_along::<2, NEAREST, PADDED>(avx, place, run, t_max, search),
         }
     }
 
@@ -520,15 +576,20 @@ impl TriangleMesh {
     fn search_run_along<const KZ: usize, const NEAREST: bool, const PADDED: bool>(
         &self,
         avx: Option<Avx>,
+        place: usize,
         run: Range<usize>,
         t_max: &mut f64,
         search: &mut Search,
     ) -> bool {
         let Search {
-            ray, sheared, hit, ..
+            ray,
+            sheared,
+            hit,
+            blocks,
+            ..
         } = search;
         let r = sheared.get_or_insert_with(|| ShearedRay::along::<KZ>(ray));
-        debug_assert!(!PADDED || run.start.is_multiple_of(LANES));
+        debug_assert!(run.start < LANES && (!PADDED || run.start == 0));
         let skip = run.start % LANES;
         let mut from = !0u32 << skip;
         let mut base = run.start - skip;
@@ -541,27 +602,36 @@ impl TriangleMesh {
                 from & ((1 << (run.end - base).min(width)) - 1)
             };
             from = !0;
-            let b = base / LANES;
-            debug_assert!(b + (pair as usize) < self.blocks.len());
-            // SAFETY: the structure's runs lie within the slots it ordered, all stored, and
-            // a pair is taken only where the run reaches into the second block.
+            let at = place + base / LANES * BLOCK_UNITS;
+            debug_assert!(
+                (at + BLOCK_UNITS * (1 + pair as usize)) * EMBED_UNIT <= self.block_bytes().len()
+            );
+            // SAFETY: the structure's runs are of stored blocks, one after another, and a
+            // pair is taken only where the run reaches into the second block.
             let found = unsafe {
+                let block = blocks.add(at * EMBED_UNIT);
                 match avx {
                     #[cfg(target_arch = "x86_64")]
                     Some(avx) if pair => {
-                        let pair = &*(self.blocks.as_ptr().add(b) as *const [Block; 2]);
+                        let pair = &*(block as *const [Block; 2]);
                         self.intersect_lanes_along::<KZ, NEAREST, F8>(
-                            avx, r, ray, pair, base, lanes, *t_max,
+                            avx,
+                            r,
+                            ray,
+                            pair,
+                            at * LANES,
+                            lanes,
+                            *t_max,
                         )
                     }
                     _ => {
-                        let block = self.blocks.get_unchecked(b);
+                        let block = &*(block as *const Block);
                         self.intersect_lanes_along::<KZ, NEAREST, F4>(
                             (),
                             r,
                             ray,
                             block,
-                            base,
+                            at * LANES,
                             lanes,
                             *t_max,
                         )
@@ -580,9 +650,9 @@ impl TriangleMesh {
         true
     }
 
-    /// The watertight test on the triangles of slots `base..` held in `blocks`, one lane of
-    /// `V` each, against the lanes set in `lanes`: the nearest hit if `NEAREST`, else the
-    /// first found.
+    /// The watertight test on the triangles held in `blocks`, one lane of `V` each, the
+    /// first block's parts from `first_part` on, against the lanes set in `lanes`: the
+    /// nearest hit if `NEAREST`, else the first found.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn intersect_lanes_along<const KZ: usize, const NEAREST: bool, V: BlockLanes>(
@@ -591,7 +661,7 @@ impl TriangleMesh {
         r: &ShearedRay,
         ray: &Ray,
         blocks: &V::Blocks,
-        base: usize,
+        first_part: usize,
         lanes: u32,
         t_max: f64,
     ) -> Option<HitRecord> {
@@ -649,7 +719,7 @@ impl TriangleMesh {
                         t: t[lane] as f64,
                         u: (e1[lane] / det[lane]) as f64,
                         v: (e2[lane] / det[lane]) as f64,
-                        part: (base + lane) as u32,
+                        part: part_of(first_part, lane),
                     });
                 }
                 if !NEAREST {
@@ -663,7 +733,7 @@ impl TriangleMesh {
             let lane = on_edge.trailing_zeros() as usize;
             on_edge &= on_edge - 1;
             let limit = best.map_or(t_max, |h| h.t);
-            let part = (base + lane) as u32;
+            let part = part_of(first_part, lane);
             if let Some((t, b1, b2)) = intersect_triangle(ray, limit, self.triangle(part)) {
                 best = Some(HitRecord {
                     t,
@@ -788,6 +858,13 @@ fn beyond_error_bound<V: Lanes>(isa: V::Isa, extent: [V; 3], e: [V; 3], det: V, 
     delta_t.lt(t)
 }
 
+/// The part of `lane` of a test whose first block's parts start at `first_part`: lanes
+/// from the fifth on are in the second block, [`BLOCK_UNITS`] further on.
+#[inline(always)]
+fn part_of(first_part: usize, lane: usize) -> u32 {
+    (first_part + lane + lane / LANES * (BLOCK_UNITS - 1) * LANES) as u32
+}
+
 /// Lanes that load corners from blocks: four lanes from one, eight from two in a row.
 trait BlockLanes: Lanes {
     type Blocks;
@@ -799,7 +876,7 @@ impl BlockLanes for F4 {
     type Blocks = Block;
     #[inline(always)]
     fn corners(_: (), block: &Block, k: usize, axis: usize) -> F4 {
-        F4::load(&block.0[k][axis])
+        F4::load(&block.corners[k][axis])
     }
 }
 
@@ -808,7 +885,11 @@ impl BlockLanes for F8 {
     type Blocks = [Block; 2];
     #[inline(always)]
     fn corners(avx: Avx, blocks: &[Block; 2], k: usize, axis: usize) -> F8 {
-        F8::join(avx, &blocks[0].0[k][axis], &blocks[1].0[k][axis])
+        F8::join(
+            avx,
+            &blocks[0].corners[k][axis],
+            &blocks[1].corners[k][axis],
+        )
     }
 }
 
@@ -837,6 +918,8 @@ struct Search<'r> {
     hit: Option<HitRecord>,
     /// Where the CPU has AVX: blocks are tested two at a time.
     avx: Option<Avx>,
+    /// Where the blocks' places are counted from ([`TriangleMesh::block_bytes`]).
+    blocks: *const u8,
 }
 
 /// A ray prepared for the watertight test: axes permuted so the direction's largest
