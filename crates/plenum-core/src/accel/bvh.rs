@@ -53,6 +53,9 @@ const EMPTY: u32 = LEAF_BIT;
 /// The unit in which [`Bvh::embed_blocks`] gives a leaf's place: blocks are a whole number
 /// of them, so every block starts on one.
 pub const EMBED_UNIT: usize = 16;
+/// The most bytes [`Bvh::embed_blocks`] lays out: interior references are byte offsets
+/// below [`LEAF_BIT`], and a leaf's place below `(START_MASK + 1) * EMBED_UNIT`, both 2 GiB.
+pub const EMBED_LIMIT: usize = LEAF_BIT as usize;
 
 /// Eight child boxes as six planes of eight lanes: min x, y, z then max x, y, z. Four cache
 /// lines exactly.
@@ -356,15 +359,17 @@ impl Bvh {
     /// Moves the caller's blocks into the nodes' array, each node followed by the blocks of
     /// its leaf children: a leaf's items then lie beside the node that names it, and the
     /// memory system, having fetched a node's lines, is already on its way to theirs (the
-    /// level-8 icosphere's incoherent rays 13 % faster for the closest hit, measured side by
-    /// side). `blocks` hold the items of [`Bvh::take_padded_order`], `lanes` to a block. A leaf's
-    /// run then starts at its first block's place in [`Bvh::embedded`], counted in
+    /// level-8 icosphere's incoherent rays 12 % faster for the closest hit, measured in one
+    /// process). `blocks` hold the items of [`Bvh::take_padded_order`], `lanes` to a block.
+    /// A leaf's run then starts at its first block's place in [`Bvh::embedded`], counted in
     /// [`EMBED_UNIT`]s, and still counts items; [`Bvh::embedded_leaves`] lists the runs.
-    pub fn embed_blocks<B: Copy>(&mut self, blocks: &[B], lanes: usize) {
+    /// Returns false, leaving the BVH as it was, where the whole would exceed `limit` bytes
+    /// or [`EMBED_LIMIT`], what references can reach, or there are no nodes.
+    pub fn embed_blocks<B: Copy>(&mut self, blocks: &[B], lanes: usize, limit: usize) -> bool {
         let block_bytes = std::mem::size_of::<B>();
         assert!(block_bytes.is_multiple_of(EMBED_UNIT) && std::mem::align_of::<B>() <= 64);
         if self.nodes.is_empty() {
-            return;
+            return false;
         }
         // SAFETY: blocks are plain data (`Copy`), read as the bytes they are.
         let blocks = unsafe {
@@ -381,6 +386,9 @@ impl Bvh {
             len: 0,
         };
         self.embed_node(0, &layout, &mut counted);
+        if counted.len > limit.min(EMBED_LIMIT) {
+            return false;
+        }
         let mut nodes = vec![self.nodes[0]; counted.len.div_ceil(NODE_BYTES as usize)];
         // SAFETY: nodes are plain data; any bytes written over them are as plain.
         let bytes = unsafe {
@@ -392,13 +400,19 @@ impl Bvh {
         self.embed_node(0, &layout, &mut Arena { bytes, len: 0 });
         self.nodes = nodes.into();
         self.embedded = true;
+        true
+    }
+
+    /// The leaves' blocks lie among the nodes ([`Bvh::embed_blocks`]).
+    pub fn is_embedded(&self) -> bool {
+        self.embedded
     }
 
     /// Lays out node `index` in `arena` with the blocks of its leaf children, then its
     /// interior children's subtrees; returns its new reference.
     fn embed_node(&self, index: usize, layout: &BlockLayout, arena: &mut Arena) -> u32 {
+        // Past EMBED_LIMIT only while counting: the references made then are dropped.
         let at = arena.take(std::mem::align_of::<Node>(), NODE_BYTES as usize);
-        assert!(at < LEAF_BIT as usize, "too many triangles for one BVH");
         let original = self.nodes[index];
         let mut node = original;
         let used = |slot: usize| original.used & (1 << slot) != 0;
@@ -412,10 +426,6 @@ impl Bvh {
             let place = arena.take(EMBED_UNIT, end - first);
             arena.put(place, &layout.blocks[first..end]);
             let place = place / EMBED_UNIT;
-            assert!(
-                place <= START_MASK as usize,
-                "too many triangles for one BVH"
-            );
             node.children[slot] = LEAF_BIT | (count << COUNT_SHIFT) | place as u32;
         }
         for slot in (0..WIDTH).filter(|&s| used(s) && !is_leaf(s)) {
@@ -995,7 +1005,10 @@ mod tests {
         // Blocks of four item numbers: 16 bytes, one unit.
         let blocks: Vec<[u32; 4]> = order.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
         let before = bvh.clone();
-        bvh.embed_blocks(&blocks, 4);
+        let mut small = bvh.clone();
+        assert!(!small.embed_blocks(&blocks, 4, 1024), "over the limit");
+        assert!(!small.is_embedded());
+        assert!(bvh.embed_blocks(&blocks, 4, EMBED_LIMIT));
         let bytes = bvh.embedded();
         let items_at = |place: usize, count: usize| -> Vec<u32> {
             let run = &bytes[place * EMBED_UNIT..][..count.next_multiple_of(4) * 4];

@@ -16,7 +16,7 @@ use crate::accel::ray_f32::{gamma_f32, round_up_distance};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::simd::F8;
 use crate::accel::simd::{Avx, Lanes, F4};
-use crate::accel::{Accel, AccelKind, LeafItems, LeafSize, EMBED_UNIT, PAD};
+use crate::accel::{Accel, AccelKind, LeafItems, LeafSize, EMBED_LIMIT, EMBED_UNIT, PAD};
 use crate::math::{gamma, Bounds3, Ray, Vec3};
 use std::ops::Range;
 
@@ -194,12 +194,18 @@ impl TriangleMesh {
             closed,
         };
         let indices = if keep_indices { triangles } else { Vec::new() };
-        mesh.store(&corners, &indices, AccelKind::Bvh);
+        mesh.store(&corners, &indices, AccelKind::Bvh, EMBED_LIMIT);
         Ok(mesh)
     }
 
     /// The mesh with its triangles in a `kind` structure instead.
     pub fn with_accel(&self, kind: AccelKind) -> TriangleMesh {
+        self.rebuilt(kind, EMBED_LIMIT)
+    }
+
+    /// [`TriangleMesh::with_accel`], a BVH holding the blocks among its nodes only if all
+    /// comes to at most `embed_limit` bytes (see [`crate::accel::Bvh::embed_blocks`]).
+    fn rebuilt(&self, kind: AccelKind, embed_limit: usize) -> TriangleMesh {
         let (corners, indices) = self.in_source_order();
         let mut mesh = TriangleMesh {
             blocks: LargeArray::default(),
@@ -209,7 +215,7 @@ impl TriangleMesh {
             accel: Accel::default(),
             ..*self
         };
-        mesh.store(&corners, &indices, kind);
+        mesh.store(&corners, &indices, kind, embed_limit);
         mesh
     }
 
@@ -217,13 +223,19 @@ impl TriangleMesh {
     /// its leaf order (see [`TriangleMesh::source_triangle`]).
     pub fn set_accel(&mut self, kind: AccelKind) {
         let (corners, indices) = self.in_source_order();
-        self.store(&corners, &indices, kind);
+        self.store(&corners, &indices, kind, EMBED_LIMIT);
     }
 
     /// Builds a `kind` structure over triangles given in the order the mesh was made from
     /// (with their vertex indices, or none), and stores them in blocks in its order: every
     /// BVH leaf, grid cell or octree leaf a run of whole blocks.
-    fn store(&mut self, corners: &[Corners], indices: &[[u32; 3]], kind: AccelKind) {
+    fn store(
+        &mut self,
+        corners: &[Corners],
+        indices: &[[u32; 3]],
+        kind: AccelKind,
+        embed_limit: usize,
+    ) {
         let bounds: Vec<Bounds3> = corners
             .iter()
             .map(|c| {
@@ -270,12 +282,16 @@ impl TriangleMesh {
                 block
             })
             .collect();
-        self.blocks = match &mut accel {
-            Accel::Bvh(bvh) => {
-                bvh.embed_blocks(&blocks, LANES);
-                LargeArray::default()
-            }
-            _ => blocks.into(),
+        // Beside a BVH's nodes, unless that would take it past what its references reach
+        // (some 40 million triangles): then in an array of their own, as for a grid.
+        let embedded = match &mut accel {
+            Accel::Bvh(bvh) => bvh.embed_blocks(&blocks, LANES, embed_limit),
+            _ => false,
+        };
+        self.blocks = if embedded {
+            LargeArray::default()
+        } else {
+            blocks.into()
         };
         self.indices = if self.keeps_indices {
             indices.to_vec()
@@ -346,7 +362,7 @@ impl TriangleMesh {
     /// list the mesh was made from.
     fn stored_parts(&self) -> impl Iterator<Item = (u32, u32)> + '_ {
         let places: Vec<usize> = match &self.accel {
-            Accel::Bvh(bvh) => bvh
+            Accel::Bvh(bvh) if bvh.is_embedded() => bvh
                 .embedded_leaves()
                 .into_iter()
                 .flat_map(|(place, count)| {
@@ -366,7 +382,7 @@ impl TriangleMesh {
     /// The stored blocks, as bytes: the BVH's nodes among them, or the blocks alone.
     fn block_bytes(&self) -> &[u8] {
         match &self.accel {
-            Accel::Bvh(bvh) => bvh.embedded(),
+            Accel::Bvh(bvh) if bvh.is_embedded() => bvh.embedded(),
             // SAFETY: blocks are plain data, read as the bytes they are.
             _ => unsafe {
                 std::slice::from_raw_parts(
@@ -453,7 +469,7 @@ impl TriangleMesh {
             blocks: self.block_bytes().as_ptr(),
         };
         match &self.accel {
-            Accel::Bvh(bvh) => {
+            Accel::Bvh(bvh) if bvh.is_embedded() => {
                 // A leaf's run starts at its first block's place.
                 let visit_run = |run: Range<usize>, t_max: &mut f64| {
                     self.search_run::<NEAREST, true>(run.start, 0..run.len(), t_max, &mut search)
@@ -470,8 +486,9 @@ impl TriangleMesh {
         search.hit
     }
 
-    /// [`TriangleMesh::search`] through the grid, the octree or brute force: apart, so that
-    /// their walks' state does not weigh on every BVH search.
+    /// [`TriangleMesh::search`] through the grid, the octree, brute force or a BVH too large
+    /// to hold the blocks among its nodes: apart, so that their walks' state does not weigh
+    /// on every BVH search.
     #[inline(never)]
     fn search_cells<const NEAREST: bool>(&self, ray: &Ray, t_max: f64, search: &mut Search) {
         // Their runs are of slots, block after block from the first.
@@ -480,7 +497,14 @@ impl TriangleMesh {
             self.search_run::<NEAREST, true>(place, 0..run.len(), t_max, search)
         };
         match &self.accel {
-            Accel::Bvh(_) => unreachable!("the BVH is searched inline"),
+            Accel::Bvh(bvh) => {
+                let items = LeafItems::<{ std::mem::size_of::<Block>() / LANES }>::at(&self.blocks);
+                if NEAREST {
+                    bvh.traverse_runs(ray, t_max, items, visit_run);
+                } else {
+                    bvh.traverse_runs_any_order(ray, t_max, items, visit_run);
+                }
+            }
             Accel::Grid(grid) => grid.traverse_runs(ray, t_max, visit_run),
             Accel::Octree(octree) => octree.traverse_runs(ray, t_max, visit_run),
             Accel::None(brute) => brute.traverse(ray, t_max, |items, t_max| {
@@ -1207,6 +1231,41 @@ mod tests {
             }
             assert!(hits > 2000, "{kind}: {hits} hits");
         }
+    }
+
+    #[test]
+    fn a_bvh_with_its_blocks_apart_finds_the_hits_of_one_with_them_among_its_nodes() {
+        // What a mesh too large to embed (some 40 million triangles) gets, here by a limit of
+        // no bytes. Rays from above at random (seed 12).
+        let (positions, triangles) = sheet(24);
+        let normals = vec![Vec3::Z; positions.len()];
+        let among = TriangleMesh::new(positions, triangles.clone(), normals, vec![]).unwrap();
+        let apart = among.rebuilt(AccelKind::Bvh, 0);
+        assert!(matches!(&among.accel, Accel::Bvh(b) if b.is_embedded()));
+        assert!(matches!(&apart.accel, Accel::Bvh(b) if !b.is_embedded()));
+        assert_eq!(apart.indexed(), among.indexed());
+        for (part, _) in apart.triangles() {
+            let source = apart.source_triangle(part) as usize;
+            assert_eq!(apart.vertex_indices(part), Some(triangles[source]));
+        }
+        let mut rng = crate::sampling::Rng::new(12, 0);
+        let mut hits = 0;
+        for _ in 0..3000 {
+            let mut u = || rng.uniform();
+            let origin = Vec3::new(u() * 30.0 - 3.0, u() * 30.0 - 3.0, 0.3 + u() * 4.0);
+            let ray = Ray::new(origin, Vec3::new(u() * 24.0, u() * 24.0, 0.0) - origin);
+            let found = |mesh: &TriangleMesh| {
+                let hit = mesh.intersect(&ray, f64::INFINITY);
+                let any = mesh.intersect_any(&ray, f64::INFINITY).is_some();
+                (
+                    hit.map(|h| (h.t, h.u, h.v, mesh.source_triangle(h.part))),
+                    any,
+                )
+            };
+            assert_eq!(found(&apart), found(&among), "{ray:?}");
+            hits += found(&among).1 as usize;
+        }
+        assert!(hits > 2000, "{hits} hits");
     }
 
     #[test]
