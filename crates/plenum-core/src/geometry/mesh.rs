@@ -38,6 +38,13 @@ struct Block {
     source: [u32; LANES],
 }
 
+impl Block {
+    /// The corners of the triangle in `lane`.
+    fn corners(&self, lane: usize) -> Corners {
+        [0, 1, 2].map(|k| [0, 1, 2].map(|a| self.corners[k][a][lane]))
+    }
+}
+
 /// A block's size in the units in which its place is counted: a stored triangle, a *part*
 /// ([`HitRecord::part`]), is its block's place (its offset from the first block's place, in
 /// [`EMBED_UNIT`]s) times [`LANES`] plus its lane.
@@ -45,6 +52,11 @@ const BLOCK_UNITS: usize = std::mem::size_of::<Block>() / EMBED_UNIT;
 
 /// A triangle's corners in f32, `[corner][axis]`.
 type Corners = [[f32; 3]; 3];
+
+/// A corner widened to f64, exactly.
+fn widened(p: [f32; 3]) -> Vec3 {
+    Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64)
+}
 
 #[derive(Clone, Debug)]
 pub struct TriangleMesh {
@@ -175,7 +187,6 @@ impl TriangleMesh {
         {
             return Err(MeshError::NonFinitePosition(i));
         }
-        let widened = |p: &[f32; 3]| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
         let closed = is_closed(&positions, &triangles);
         let corners: Vec<Corners> = triangles
             .iter()
@@ -190,7 +201,7 @@ impl TriangleMesh {
             vertex_count: positions.len(),
             triangle_count: triangles.len(),
             accel: Accel::default(),
-            bounds: Bounds3::from_points(positions.iter().map(widened)),
+            bounds: Bounds3::from_points(positions.iter().copied().map(widened)),
             closed,
         };
         let indices = if keep_indices { triangles } else { Vec::new() };
@@ -238,10 +249,7 @@ impl TriangleMesh {
     ) {
         let bounds: Vec<Bounds3> = corners
             .iter()
-            .map(|c| {
-                let widened = c.map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
-                Bounds3::from_points(widened)
-            })
+            .map(|c| Bounds3::from_points(c.map(widened)))
             .collect();
         let mut accel = Accel::build(kind, &bounds, LEAF);
         let mut order = match &mut accel {
@@ -403,14 +411,12 @@ impl TriangleMesh {
 
     /// The corners of stored triangle `part`.
     pub fn triangle(&self, part: u32) -> [Vec3; 3] {
-        self.corners_f32(part)
-            .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+        self.corners_f32(part).map(widened)
     }
 
     fn corners_f32(&self, part: u32) -> Corners {
         let (place, lane) = (part as usize / LANES, part as usize % LANES);
-        let b = &self.block_at(place).corners;
-        [0, 1, 2].map(|k| [0, 1, 2].map(|a| b[k][a][lane]))
+        self.block_at(place).corners(lane)
     }
 
     /// The vertex indices of stored triangle `part`, where the mesh keeps them (it has
@@ -433,8 +439,7 @@ impl TriangleMesh {
     pub fn indexed(&self) -> (Vec<Vec3>, Vec<[u32; 3]>) {
         let (corners, indices) = self.in_source_order();
         let (vertices, triangles) = index_corners(&corners, &indices, self.vertex_count);
-        let widened = |p: &[f32; 3]| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
-        (vertices.iter().map(widened).collect(), triangles)
+        (vertices.iter().copied().map(widened).collect(), triangles)
     }
 
     pub fn bounds(&self) -> Bounds3 {
@@ -758,7 +763,9 @@ impl TriangleMesh {
             on_edge &= on_edge - 1;
             let limit = best.map_or(t_max, |h| h.t);
             let part = part_of(first_part, lane);
-            if let Some((t, b1, b2)) = intersect_triangle(ray, limit, self.triangle(part)) {
+            // Read from the block in hand: looking the part up would weigh on every call.
+            let corners = V::corners_of_lane(blocks, lane).map(widened);
+            if let Some((t, b1, b2)) = intersect_triangle(ray, limit, corners) {
                 best = Some(HitRecord {
                     t,
                     u: b1,
@@ -894,6 +901,8 @@ trait BlockLanes: Lanes {
     type Blocks;
     /// Coordinate `axis` of corner `k` of every lane's triangle.
     fn corners(isa: Self::Isa, blocks: &Self::Blocks, k: usize, axis: usize) -> Self;
+    /// The corners of one lane's triangle.
+    fn corners_of_lane(blocks: &Self::Blocks, lane: usize) -> Corners;
 }
 
 impl BlockLanes for F4 {
@@ -901,6 +910,9 @@ impl BlockLanes for F4 {
     #[inline(always)]
     fn corners(_: (), block: &Block, k: usize, axis: usize) -> F4 {
         F4::load(&block.corners[k][axis])
+    }
+    fn corners_of_lane(block: &Block, lane: usize) -> Corners {
+        block.corners(lane)
     }
 }
 
@@ -914,6 +926,9 @@ impl BlockLanes for F8 {
             &blocks[0].corners[k][axis],
             &blocks[1].corners[k][axis],
         )
+    }
+    fn corners_of_lane(blocks: &[Block; 2], lane: usize) -> Corners {
+        blocks[lane / LANES % 2].corners(lane % LANES)
     }
 }
 
