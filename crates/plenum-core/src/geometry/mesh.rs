@@ -522,11 +522,11 @@ impl TriangleMesh {
         }
     }
 
-    /// Tests the blocks of a run of slots, read in place: lowers `t_max` to each nearer hit
-    /// if `NEAREST`, else returns false at the first. A structure's run is `PADDED`: it
-    /// starts a block, and the lanes of its last block past its end are padding, which
-    /// misses (NaN corners). Otherwise (brute force's single slots) lanes outside the run
-    /// are left out. The loops themselves (`search_run_sse`, `search_run_avx`) are kept out
+    /// Tests a run of lanes of the blocks from `place` on, one after another, read in place:
+    /// lowers `t_max` to each nearer hit if `NEAREST`, else returns false at the first. A
+    /// structure's run is `PADDED`: it starts at the first block's first lane, and the lanes
+    /// of its last block past its end are padding, which misses (NaN corners). Otherwise
+    /// (brute force's single slots) lanes outside the run are left out. The loops themselves (`search_run_sse`, `search_run_avx`) are kept out
     /// of the traversal loop: inlined there, they leave it too few registers.
     #[inline(always)]
     fn search_run<const NEAREST: bool, const PADDED: bool>(
