@@ -476,8 +476,11 @@ impl TriangleMesh {
         match &self.accel {
             Accel::Bvh(bvh) if bvh.is_embedded() => {
                 // A leaf's run starts at its first block's place.
+                let origin = bvh.embedded().as_ptr();
                 let visit_run = |run: Range<usize>, t_max: &mut f64| {
-                    self.search_run::<NEAREST, true>(run.start, 0..run.len(), t_max, &mut search)
+                    // SAFETY: a leaf's place is its first block's, within the nodes' array.
+                    let first = unsafe { origin.add(run.start * EMBED_UNIT) } as *const Block;
+                    self.search_run::<NEAREST, true>(first, 0..run.len(), t_max, &mut search)
                 };
                 let items = LeafItems::<EMBED_UNIT>::at(bvh.embedded());
                 if NEAREST {
@@ -498,8 +501,9 @@ impl TriangleMesh {
     fn search_cells<const NEAREST: bool>(&self, ray: &Ray, t_max: f64, search: &mut Search) {
         // Their runs are of slots, block after block from the first.
         let visit_run = |run: Range<usize>, t_max: &mut f64| {
-            let place = run.start / LANES * BLOCK_UNITS;
-            self.search_run::<NEAREST, true>(place, 0..run.len(), t_max, search)
+            // SAFETY: the runs are of the blocks' slots.
+            let first = unsafe { self.blocks.as_ptr().add(run.start / LANES) };
+            self.search_run::<NEAREST, true>(first, 0..run.len(), t_max, search)
         };
         match &self.accel {
             Accel::Bvh(bvh) => {
@@ -514,15 +518,16 @@ impl TriangleMesh {
             Accel::Octree(octree) => octree.traverse_runs(ray, t_max, visit_run),
             Accel::None(brute) => brute.traverse(ray, t_max, |items, t_max| {
                 items.iter().all(|&slot| {
-                    let (place, lane) =
-                        (slot as usize / LANES * BLOCK_UNITS, slot as usize % LANES);
-                    self.search_run::<NEAREST, false>(place, lane..lane + 1, t_max, search)
+                    let (block, lane) = (slot as usize / LANES, slot as usize % LANES);
+                    // SAFETY: brute force names the slots of the blocks.
+                    let first = unsafe { self.blocks.as_ptr().add(block) };
+                    self.search_run::<NEAREST, false>(first, lane..lane + 1, t_max, search)
                 })
             }),
         }
     }
 
-    /// Tests a run of lanes of the blocks from `place` on, one after another, read in place:
+    /// Tests a run of lanes of the blocks from `first` on, one after another, read in place:
     /// lowers `t_max` to each nearer hit if `NEAREST`, else returns false at the first. A
     /// structure's run is `PADDED`: it starts at the first block's first lane, and the lanes
     /// of its last block past its end are padding, which misses (NaN corners). Otherwise
@@ -531,7 +536,7 @@ impl TriangleMesh {
     #[inline(always)]
     fn search_run<const NEAREST: bool, const PADDED: bool>(
         &self,
-        place: usize,
+        first: *const Block,
         run: Range<usize>,
         t_max: &mut f64,
         search: &mut Search,
@@ -540,22 +545,22 @@ impl TriangleMesh {
         if let Some(avx) = search.avx {
             // SAFETY: `avx` says the CPU has AVX.
             return unsafe {
-                self.search_run_avx::<NEAREST, PADDED>(avx, place, run, t_max, search)
+                self.search_run_avx::<NEAREST, PADDED>(avx, first, run, t_max, search)
             };
         }
-        self.search_run_sse::<NEAREST, PADDED>(place, run, t_max, search)
+        self.search_run_sse::<NEAREST, PADDED>(first, run, t_max, search)
     }
 
     /// The leaf loop testing four triangles at a time.
     #[inline(never)]
     fn search_run_sse<const NEAREST: bool, const PADDED: bool>(
         &self,
-        place: usize,
+        first: *const Block,
         run: Range<usize>,
         t_max: &mut f64,
         search: &mut Search,
     ) -> bool {
-        self.search_run_with::<NEAREST, PADDED>(None, place, run, t_max, search)
+        self.search_run_with::<NEAREST, PADDED>(None, first, run, t_max, search)
     }
 
     /// The leaf loop testing two blocks, eight triangles, at a time where a run has them,
@@ -569,12 +574,12 @@ impl TriangleMesh {
     unsafe fn search_run_avx<const NEAREST: bool, const PADDED: bool>(
         &self,
         avx: Avx,
-        place: usize,
+        first: *const Block,
         run: Range<usize>,
         t_max: &mut f64,
         search: &mut Search,
     ) -> bool {
-        self.search_run_with::<NEAREST, PADDED>(Some(avx), place, run, t_max, search)
+        self.search_run_with::<NEAREST, PADDED>(Some(avx), first, run, t_max, search)
     }
 
     /// The leaf loop, testing blocks in pairs where `avx` is given.
@@ -582,7 +587,7 @@ impl TriangleMesh {
     fn search_run_with<const NEAREST: bool, const PADDED: bool>(
         &self,
         avx: Option<Avx>,
-        place: usize,
+        first: *const Block,
         run: Range<usize>,
         t_max: &mut f64,
         search: &mut Search,
@@ -594,9 +599,9 @@ impl TriangleMesh {
             None => search.ray.direction.max_abs_axis(),
         };
         match kz {
-            0 => self.search_run_along::<0, NEAREST, PADDED>(avx, place, run, t_max, search),
-            1 => self.search_run_along::<1, NEAREST, PADDED>(avx, place, run, t_max, search),
-            _ => self.search_run_along::<2, NEAREST, PADDED>(avx, place, run, t_max, search),
+            0 => self.search_run_along::<0, NEAREST, PADDED>(avx, first, run, t_max, search),
+            1 => self.search_run_along::<1, NEAREST, PADDED>(avx, first, run, t_max, search),
+            _ => self.search_run_along::<2, NEAREST, PADDED>(avx, first, run, t_max, search),
         }
     }
 
@@ -605,7 +610,7 @@ impl TriangleMesh {
     fn search_run_along<const KZ: usize, const NEAREST: bool, const PADDED: bool>(
         &self,
         avx: Option<Avx>,
-        place: usize,
+        first: *const Block,
         run: Range<usize>,
         t_max: &mut f64,
         search: &mut Search,
@@ -631,40 +636,27 @@ impl TriangleMesh {
                 from & ((1 << (run.end - base).min(width)) - 1)
             };
             from = !0;
-            let at = place + base / LANES * BLOCK_UNITS;
-            debug_assert!(
-                (at + BLOCK_UNITS * (1 + pair as usize)) * EMBED_UNIT <= self.block_bytes().len()
-            );
             // SAFETY: the structure's runs are of stored blocks, one after another, and a
             // pair is taken only where the run reaches into the second block.
             let found = unsafe {
-                let block = blocks.add(at * EMBED_UNIT);
+                let block = first.add(base / LANES);
                 match avx {
                     #[cfg(target_arch = "x86_64")]
                     Some(avx) if pair => {
                         let pair = &*(block as *const [Block; 2]);
                         self.intersect_lanes_along::<KZ, NEAREST, F8>(
-                            avx,
-                            r,
-                            ray,
-                            pair,
-                            at * LANES,
-                            lanes,
-                            *t_max,
+                            avx, r, ray, pair, *blocks, lanes, *t_max,
                         )
                     }
-                    _ => {
-                        let block = &*(block as *const Block);
-                        self.intersect_lanes_along::<KZ, NEAREST, F4>(
-                            (),
-                            r,
-                            ray,
-                            block,
-                            at * LANES,
-                            lanes,
-                            *t_max,
-                        )
-                    }
+                    _ => self.intersect_lanes_along::<KZ, NEAREST, F4>(
+                        (),
+                        r,
+                        ray,
+                        &*block,
+                        *blocks,
+                        lanes,
+                        *t_max,
+                    ),
                 }
             };
             if let Some(h) = found {
@@ -679,9 +671,9 @@ impl TriangleMesh {
         true
     }
 
-    /// The watertight test on the triangles held in `blocks`, one lane of `V` each, the
-    /// first block's parts from `first_part` on, against the lanes set in `lanes`: the
-    /// nearest hit if `NEAREST`, else the first found.
+    /// The watertight test on the triangles held in `blocks`, one lane of `V` each, against
+    /// the lanes set in `lanes`: the nearest hit if `NEAREST`, else the first found. A hit
+    /// names its part by the block's place from `places_from` (see [`BLOCK_UNITS`]).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn intersect_lanes_along<const KZ: usize, const NEAREST: bool, V: BlockLanes>(
@@ -690,11 +682,14 @@ impl TriangleMesh {
         r: &ShearedRay,
         ray: &Ray,
         blocks: &V::Blocks,
-        first_part: usize,
+        places_from: *const u8,
         lanes: u32,
         t_max: f64,
     ) -> Option<HitRecord> {
         let (kx, ky) = ((KZ + 1) % 3, (KZ + 2) % 3);
+        // Worked out only for a hit: the block's place times its lanes.
+        let first_part =
+            || (blocks as *const V::Blocks as usize - places_from as usize) / (EMBED_UNIT / LANES);
         let splat = |v: f32| V::splat(isa, v);
         let origin = [splat(r.origin[0]), splat(r.origin[1]), splat(r.origin[2])];
         let shear = [splat(r.shear[0]), splat(r.shear[1]), splat(r.shear[2])];
@@ -748,7 +743,7 @@ impl TriangleMesh {
                         t: t[lane] as f64,
                         u: (e1[lane] / det[lane]) as f64,
                         v: (e2[lane] / det[lane]) as f64,
-                        part: part_of(first_part, lane),
+                        part: part_of(first_part(), lane),
                     });
                 }
                 if !NEAREST {
@@ -762,7 +757,7 @@ impl TriangleMesh {
             let lane = on_edge.trailing_zeros() as usize;
             on_edge &= on_edge - 1;
             let limit = best.map_or(t_max, |h| h.t);
-            let part = part_of(first_part, lane);
+            let part = part_of(first_part(), lane);
             // Read from the block in hand: looking the part up would weigh on every call.
             let corners = V::corners_of_lane(blocks, lane).map(widened);
             if let Some((t, b1, b2)) = intersect_triangle(ray, limit, corners) {
