@@ -313,15 +313,11 @@ impl TriangleMesh {
     /// them (else none), in the order the mesh was made from.
     fn in_source_order(&self) -> (Vec<Corners>, Vec<[u32; 3]>) {
         let mut corners = vec![[[0.0; 3]; 3]; self.triangle_count];
-        let kept = if self.keeps_indices {
-            self.triangle_count
-        } else {
-            0
-        };
         for (part, s) in self.stored_parts() {
             corners[s as usize] = self.corners_f32(part);
         }
-        (corners, self.indices[..kept].to_vec())
+        // Kept in that order already (or empty).
+        (corners, self.indices.clone())
     }
 
     /// Bytes the mesh occupies: corners, indices, attributes and the acceleration structure.
@@ -483,11 +479,7 @@ impl TriangleMesh {
                     self.search_run::<NEAREST, true>(first, 0..run.len(), t_max, &mut search)
                 };
                 let items = LeafItems::<EMBED_UNIT>::at(bvh.embedded());
-                if NEAREST {
-                    bvh.traverse_runs(ray, t_max, items, visit_run);
-                } else {
-                    bvh.traverse_runs_any_order(ray, t_max, items, visit_run);
-                }
+                traverse_bvh::<NEAREST, _>(bvh, ray, t_max, items, visit_run);
             }
             _ => self.search_cells::<NEAREST>(ray, t_max, &mut search),
         }
@@ -508,11 +500,7 @@ impl TriangleMesh {
         match &self.accel {
             Accel::Bvh(bvh) => {
                 let items = LeafItems::<{ std::mem::size_of::<Block>() / LANES }>::at(&self.blocks);
-                if NEAREST {
-                    bvh.traverse_runs(ray, t_max, items, visit_run);
-                } else {
-                    bvh.traverse_runs_any_order(ray, t_max, items, visit_run);
-                }
+                traverse_bvh::<NEAREST, _>(bvh, ray, t_max, items, visit_run);
             }
             Accel::Grid(grid) => grid.traverse_runs(ray, t_max, visit_run),
             Accel::Octree(octree) => octree.traverse_runs(ray, t_max, visit_run),
@@ -882,6 +870,22 @@ fn beyond_error_bound<V: Lanes>(isa: V::Isa, extent: [V; 3], e: [V; 3], det: V, 
         .mul(splat(3.0))
         .div(det.abs());
     delta_t.lt(t)
+}
+
+/// The BVH's runs for `visit`: nearest first if `NEAREST`, else in any order.
+#[inline(always)]
+fn traverse_bvh<const NEAREST: bool, const STRIDE: usize>(
+    bvh: &crate::accel::Bvh,
+    ray: &Ray,
+    t_max: f64,
+    items: LeafItems<STRIDE>,
+    visit: impl FnMut(Range<usize>, &mut f64) -> bool,
+) {
+    if NEAREST {
+        bvh.traverse_runs(ray, t_max, items, visit);
+    } else {
+        bvh.traverse_runs_any_order(ray, t_max, items, visit);
+    }
 }
 
 /// The part of `lane` of a test whose first block's parts start at `first_part`: lanes
