@@ -8,7 +8,7 @@
 //! `madvise`), as Embree's allocator asks for its BVHs. Elsewhere, or for an array a
 //! second-level TLB maps whole in 4 KiB pages, the array is an ordinary allocation: on
 //! structures of a few megabytes (the bunny's and the dragon's, traced by two threads) huge
-//! pages measured 1–6 % slower, on the 70 MB level-8 icosphere 2–12 % faster.
+//! pages measured up to 8 % slower, on the 70 MB level-8 icosphere up to 14 % faster.
 
 use std::ops::{Deref, DerefMut};
 use std::ptr::NonNull;
