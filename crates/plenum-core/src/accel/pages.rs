@@ -178,9 +178,9 @@ mod tests {
             0,
             1,
             1000,
-            HUGE_PAGE / 4 - 1,
-            HUGE_PAGE / 4,
             3 * HUGE_PAGE / 4 + 7,
+            HUGE_PAGES_FROM / 4 - 1,
+            HUGE_PAGES_FROM / 4,
             HUGE_PAGES_FROM / 4 + 7,
         ] {
             let items: Vec<u32> = (0..len as u32)
