@@ -15,12 +15,12 @@
 //! and the ray origin is rounded up or down per plane so that the f32 origin never moves a
 //! box out of the ray's way.
 
-use super::append_padded;
 use super::pages::LargeArray;
 #[cfg(target_arch = "x86_64")]
 use super::ray_f32::BoxRayAvx;
 use super::ray_f32::{round_down, round_up, round_up_distance, BoxRay};
 use super::simd::F4;
+use super::{append_padded, bytes_of};
 use crate::math::{Bounds3, Ray};
 use std::mem::MaybeUninit;
 use std::ops::Range;
@@ -371,12 +371,8 @@ impl Bvh {
         if self.nodes.is_empty() {
             return false;
         }
-        // SAFETY: blocks are plain data (`Copy`), read as the bytes they are.
-        let blocks = unsafe {
-            std::slice::from_raw_parts(blocks.as_ptr() as *const u8, std::mem::size_of_val(blocks))
-        };
         let layout = BlockLayout {
-            blocks,
+            blocks: bytes_of(blocks),
             block_bytes,
             lanes,
         };
@@ -432,22 +428,26 @@ impl Bvh {
             let child = original.children[slot] / NODE_BYTES;
             node.children[slot] = self.embed_node(child as usize, layout, arena);
         }
-        // SAFETY: a node is plain data, read as the bytes it is.
-        let node_bytes = unsafe {
-            std::slice::from_raw_parts(&node as *const Node as *const u8, NODE_BYTES as usize)
-        };
-        arena.put(at, node_bytes);
+        arena.put(at, bytes_of(std::slice::from_ref(&node)));
         at as u32
     }
 
     /// The nodes and, after [`Bvh::embed_blocks`], the blocks among them, as bytes.
     pub fn embedded(&self) -> &[u8] {
-        // SAFETY: nodes are plain data, and so were the blocks copied among them.
+        bytes_of(&self.nodes)
+    }
+
+    /// The node whose reference is `offset` (see [`LEAF_BIT`]).
+    #[inline(always)]
+    fn node_at(&self, offset: usize) -> &Node {
+        debug_assert!(offset.is_multiple_of(std::mem::align_of::<Node>()));
+        debug_assert!(offset + NODE_BYTES as usize <= self.embedded().len());
+        // SAFETY: interior references are byte offsets of nodes, written by
+        // `flatten_children` or `embed_node`.
         unsafe {
-            std::slice::from_raw_parts(
-                self.nodes.as_ptr() as *const u8,
-                std::mem::size_of_val(&*self.nodes),
-            )
+            &*(self.nodes.as_ptr() as *const u8)
+                .add(offset)
+                .cast::<Node>()
         }
     }
 
@@ -462,12 +462,7 @@ impl Bvh {
             vec![0u32]
         };
         while let Some(reference) = pending.pop() {
-            // SAFETY: interior references are byte offsets of nodes (see `embed_node`).
-            let node = unsafe {
-                &*(self.nodes.as_ptr() as *const u8)
-                    .add(reference as usize)
-                    .cast::<Node>()
-            };
+            let node = self.node_at(reference as usize);
             for slot in (0..WIDTH).filter(|&s| node.used & (1 << s) != 0) {
                 let child = node.children[slot];
                 if child & LEAF_BIT != 0 {
@@ -582,15 +577,7 @@ impl Bvh {
                     far = round_up_distance(t_max);
                 }
             } else {
-                debug_assert!(current.is_multiple_of(std::mem::align_of::<Node>()));
-                debug_assert!(current + NODE_BYTES as usize <= self.embedded().len());
-                // SAFETY: interior references are byte offsets of nodes, written by
-                // `flatten_children` or `embed_node`.
-                let node = unsafe {
-                    &*(self.nodes.as_ptr() as *const u8)
-                        .add(current)
-                        .cast::<Node>()
-                };
+                let node = self.node_at(current);
                 let (near, hits) = test(&node.planes, far);
                 // Eight lanes: indices below stay under eight.
                 let mut hits = hits & node.used & 0xFF;

@@ -24,6 +24,13 @@ pub use octree::Octree;
 
 use crate::math::{Bounds3, Ray};
 
+/// Plain data (`Copy`: numbers, arrays and structs of them) read as the bytes it is, for
+/// laying blocks out among a BVH's nodes and finding them there.
+pub(crate) fn bytes_of<T: Copy>(items: &[T]) -> &[u8] {
+    // SAFETY: the bytes of `items`, borrowed as long as they are.
+    unsafe { std::slice::from_raw_parts(items.as_ptr() as *const u8, std::mem::size_of_val(items)) }
+}
+
 /// An item whose box has more than this share of the scene box's surface area is large.
 const LARGE_SHARE: f64 = 0.25;
 /// Most large items a spatial subdivision keeps out of its cells.

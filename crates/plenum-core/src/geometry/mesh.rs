@@ -16,7 +16,7 @@ use crate::accel::ray_f32::{gamma_f32, round_up_distance};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::simd::F8;
 use crate::accel::simd::{Avx, Lanes, F4};
-use crate::accel::{Accel, AccelKind, LeafItems, LeafSize, EMBED_LIMIT, EMBED_UNIT, PAD};
+use crate::accel::{bytes_of, Accel, AccelKind, LeafItems, LeafSize, EMBED_LIMIT, EMBED_UNIT, PAD};
 use crate::math::{gamma, Bounds3, Ray, Vec3};
 use std::ops::Range;
 
@@ -387,13 +387,7 @@ impl TriangleMesh {
     fn block_bytes(&self) -> &[u8] {
         match &self.accel {
             Accel::Bvh(bvh) if bvh.is_embedded() => bvh.embedded(),
-            // SAFETY: blocks are plain data, read as the bytes they are.
-            _ => unsafe {
-                std::slice::from_raw_parts(
-                    self.blocks.as_ptr() as *const u8,
-                    std::mem::size_of_val(&*self.blocks),
-                )
-            },
+            _ => bytes_of(&self.blocks),
         }
     }
 
@@ -519,8 +513,9 @@ impl TriangleMesh {
     /// lowers `t_max` to each nearer hit if `NEAREST`, else returns false at the first. A
     /// structure's run is `PADDED`: it starts at the first block's first lane, and the lanes
     /// of its last block past its end are padding, which misses (NaN corners). Otherwise
-    /// (brute force's single slots) lanes outside the run are left out. The loops themselves (`search_run_sse`, `search_run_avx`) are kept out
-    /// of the traversal loop: inlined there, they leave it too few registers.
+    /// (brute force's single slots) lanes outside the run are left out. The loops themselves
+    /// (`search_run_sse`, `search_run_avx`) are kept out of the traversal loop: inlined
+    /// there, they leave it too few registers.
     #[inline(always)]
     fn search_run<const NEAREST: bool, const PADDED: bool>(
         &self,
