@@ -290,15 +290,15 @@ impl Bvh {
     /// bytes, where the leaf follows its node directly). Without branches: whether a child is
     /// a leaf is a coin toss to the branch predictor.
     #[inline(always)]
-    fn prefetch<const STRIDE: usize>(&self, child: u32, items: LeafItems<STRIDE>) {
+    fn prefetch(&self, child: u32, items: impl LeafPlaces) {
         #[cfg(target_arch = "x86_64")]
         {
             let is_node = child & LEAF_BIT == 0;
             let node = (self.nodes.as_ptr() as *const i8).wrapping_add(child as usize);
-            let leaf = items
-                .base
-                .wrapping_add((child & START_MASK) as usize * STRIDE)
-                as *const i8;
+            let leaf = items.leaf(
+                self.nodes.as_ptr() as *const u8,
+                (child & START_MASK) as usize,
+            ) as *const i8;
             let p = std::hint::select_unpredictable(is_node, node, leaf);
             // SAFETY: prefetching is only a hint; it never faults, so the address needs no
             // bounds check.
@@ -480,14 +480,14 @@ impl Bvh {
     /// `items` says where the runs' items lie, so that a leaf's items can be fetched ahead
     /// of their test.
     #[inline]
-    pub fn traverse_runs<const STRIDE: usize>(
+    pub fn traverse_runs<L: LeafPlaces>(
         &self,
         ray: &Ray,
         t_max: f64,
-        items: LeafItems<STRIDE>,
+        items: L,
         visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
-        self.traverse_dispatch::<true, STRIDE>(ray, t_max, items, visit);
+        self.traverse_dispatch::<true, L>(ray, t_max, items, visit);
     }
 
     /// [`Bvh::traverse_runs`] for a caller that stops at any hit, such as a shadow ray: the
@@ -495,22 +495,22 @@ impl Bvh {
     /// and `visit` must not lower `t_max` (it stops instead), which spares comparing each
     /// waiting child's distance with it.
     #[inline]
-    pub fn traverse_runs_any_order<const STRIDE: usize>(
+    pub fn traverse_runs_any_order<L: LeafPlaces>(
         &self,
         ray: &Ray,
         t_max: f64,
-        items: LeafItems<STRIDE>,
+        items: L,
         visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
-        self.traverse_dispatch::<false, STRIDE>(ray, t_max, items, visit);
+        self.traverse_dispatch::<false, L>(ray, t_max, items, visit);
     }
 
     #[inline(always)]
-    fn traverse_dispatch<const NEAREST_FIRST: bool, const STRIDE: usize>(
+    fn traverse_dispatch<const NEAREST_FIRST: bool, L: LeafPlaces>(
         &self,
         ray: &Ray,
         t_max: f64,
-        items: LeafItems<STRIDE>,
+        items: L,
         visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
         if self.nodes.is_empty() {
@@ -519,10 +519,10 @@ impl Bvh {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx") && std::is_x86_feature_detected!("fma") {
             // SAFETY: the CPU has AVX and FMA.
-            return unsafe { self.traverse_avx::<NEAREST_FIRST, STRIDE>(ray, t_max, items, visit) };
+            return unsafe { self.traverse_avx::<NEAREST_FIRST, L>(ray, t_max, items, visit) };
         }
         let r = BoxRay::new(ray);
-        self.traverse_with::<NEAREST_FIRST, STRIDE>(t_max, items, visit, |planes, far| {
+        self.traverse_with::<NEAREST_FIRST, L>(t_max, items, visit, |planes, far| {
             r.test8(planes, F4::splat(far))
         });
     }
@@ -533,16 +533,16 @@ impl Bvh {
     /// The CPU must support AVX and FMA.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx,fma")]
-    unsafe fn traverse_avx<const NEAREST_FIRST: bool, const STRIDE: usize>(
+    unsafe fn traverse_avx<const NEAREST_FIRST: bool, L: LeafPlaces>(
         &self,
         ray: &Ray,
         t_max: f64,
-        items: LeafItems<STRIDE>,
+        items: L,
         visit: impl FnMut(Range<usize>, &mut f64) -> bool,
     ) {
         // SAFETY: this function runs only where the CPU has AVX and FMA.
         let wide = unsafe { BoxRayAvx::new(ray) };
-        self.traverse_with::<NEAREST_FIRST, STRIDE>(t_max, items, visit, |planes, far| unsafe {
+        self.traverse_with::<NEAREST_FIRST, L>(t_max, items, visit, |planes, far| unsafe {
             wide.test8(planes, far)
         });
     }
@@ -550,17 +550,17 @@ impl Bvh {
     /// The traversal, with `test(planes, far)` giving a node's eight entry distances and
     /// the mask of the children the ray crosses before `far`.
     #[inline(always)]
-    fn traverse_with<const NEAREST_FIRST: bool, const STRIDE: usize>(
+    fn traverse_with<const NEAREST_FIRST: bool, L: LeafPlaces>(
         &self,
         t_max: f64,
-        items: LeafItems<STRIDE>,
+        items: L,
         mut visit: impl FnMut(Range<usize>, &mut f64) -> bool,
         test: impl Fn(&[[f32; WIDTH]; 6], f32) -> ([f32; WIDTH], u32),
     ) {
         let mut t_max = t_max;
         let mut far = round_up_distance(t_max);
         // Uninitialised: only entries below `top`, all written first, are read.
-        let mut stack = [MaybeUninit::<(u32, f32)>::uninit(); STACK];
+        let mut stack = [MaybeUninit::<u64>::uninit(); STACK];
         let mut top = 0usize;
         // A reference widened once where it is read: kept as u32, it is widened again
         // before every use as an offset.
@@ -602,38 +602,47 @@ impl Bvh {
                             self.prefetch(node.children[i], items);
                             debug_assert!(top < STACK);
                             // SAFETY: `top` stays below STACK (see there).
-                            unsafe { stack.get_unchecked_mut(top).write((node.children[i], 0.0)) };
+                            unsafe {
+                                stack
+                                    .get_unchecked_mut(top)
+                                    .write(waiting(node.children[i], 0.0))
+                            };
                             top += 1;
                         }
                         continue;
                     }
-                    // The nearest hit child is visited next; the others wait on the stack,
-                    // nearest on top.
-                    let mut best = (node.children[first], near[first]);
+                    // The nearest hit child is visited next, chosen by a branch: where it is
+                    // predicted, the child's load need not wait for the distances. The
+                    // others wait on the stack, nearest on top, put in place without
+                    // branches: how far an entry sinks is a coin toss on incoherent rays.
+                    let mut best = waiting(node.children[first], near[first]);
                     let base = top;
                     while hits != 0 {
                         let i = hits.trailing_zeros() as usize & 7;
                         hits &= hits - 1;
-                        let mut entry = (node.children[i], near[i]);
-                        self.prefetch(entry.0, items);
-                        if entry.1 < best.1 {
-                            std::mem::swap(&mut entry, &mut best);
+                        let mut farther = waiting(node.children[i], near[i]);
+                        self.prefetch(node.children[i], items);
+                        if farther < best {
+                            std::mem::swap(&mut farther, &mut best);
                         }
-                        // Insert keeping [base, top) sorted by decreasing distance.
+                        // Insert keeping [base, top) sorted by decreasing distance: the new
+                        // entry sinks past every nearer one, each step a minimum and a
+                        // maximum.
                         debug_assert!(top < STACK);
                         // SAFETY: `top` stays below STACK (see there); entries in [base, top)
                         // were written above.
                         unsafe {
-                            let mut j = top;
-                            while j > base && stack.get_unchecked(j - 1).assume_init().1 < entry.1 {
-                                *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
-                                j -= 1;
+                            stack.get_unchecked_mut(top).write(farther);
+                            for j in (base + 1..=top).rev() {
+                                let below = stack.get_unchecked(j - 1).assume_init();
+                                let above = stack.get_unchecked(j).assume_init();
+                                stack.get_unchecked_mut(j - 1).write(below.max(above));
+                                stack.get_unchecked_mut(j).write(below.min(above));
                             }
-                            stack.get_unchecked_mut(j).write(entry);
                         }
                         top += 1;
                     }
-                    current = best.0 as usize;
+                    current = best as u32 as usize;
                     continue;
                 }
             }
@@ -645,14 +654,22 @@ impl Bvh {
                 }
                 top -= 1;
                 // SAFETY: entries below `top` were written when pushed.
-                let (next, near) = unsafe { stack.get_unchecked(top).assume_init() };
-                if !NEAREST_FIRST || near <= limit {
-                    current = next as usize;
+                let next = unsafe { stack.get_unchecked(top).assume_init() };
+                if !NEAREST_FIRST || f32::from_bits((next >> 32) as u32) <= limit {
+                    current = next as u32 as usize;
                     break;
                 }
             }
         }
     }
+}
+
+/// A child waiting on the traversal stack: its entry distance, never negative, in the high
+/// half and its reference in the low half. Non-negative floats order as their bits, so the
+/// nearer of two entries is the smaller number.
+#[inline(always)]
+fn waiting(child: u32, near: f32) -> u64 {
+    (u64::from(near.to_bits()) << 32) | u64::from(child)
 }
 
 /// The caller's blocks for [`Bvh::embed_blocks`], as bytes: `lanes` items to a block.
@@ -699,6 +716,33 @@ impl<const STRIDE: usize> LeafItems<STRIDE> {
         LeafItems {
             base: items.as_ptr() as *const u8,
         }
+    }
+}
+
+/// The blocks [`Bvh::embed_blocks`] laid out among the nodes, [`EMBED_UNIT`]s from the
+/// start of the nodes' array: found from the nodes' address, which the traversal holds
+/// anyway, so that theirs takes no register of its own.
+#[derive(Clone, Copy)]
+pub struct AmongNodes;
+
+/// Where a leaf's items lie, for prefetching: [`LeafItems`] or [`AmongNodes`].
+pub trait LeafPlaces: Copy {
+    /// The address of the items of a run starting at `start`, for a BVH whose nodes are
+    /// at `nodes`.
+    fn leaf(self, nodes: *const u8, start: usize) -> *const u8;
+}
+
+impl<const STRIDE: usize> LeafPlaces for LeafItems<STRIDE> {
+    #[inline(always)]
+    fn leaf(self, _: *const u8, start: usize) -> *const u8 {
+        self.base.wrapping_add(start * STRIDE)
+    }
+}
+
+impl LeafPlaces for AmongNodes {
+    #[inline(always)]
+    fn leaf(self, nodes: *const u8, start: usize) -> *const u8 {
+        nodes.wrapping_add(start * EMBED_UNIT)
     }
 }
 
@@ -945,6 +989,45 @@ mod tests {
                 Bounds3::new(c, c + Vec3::ONE * 0.02)
             })
             .collect()
+    }
+
+    #[test]
+    fn children_are_visited_nearest_first() {
+        use crate::math::Vec3;
+        // A row of 300 unit boxes in x, spread out in y and z so that eight-wide nodes hold
+        // boxes side by side: a ray down the row must meet every box crossing it in order,
+        // whichever way it runs, and any order must still meet them all.
+        let boxes: Vec<Bounds3> = (0..300)
+            .map(|i| {
+                let c = Vec3::new(i as f64 * 1.5, (i % 5) as f64 * 0.1, (i % 3) as f64 * 0.1);
+                Bounds3::new(c, c + Vec3::ONE)
+            })
+            .collect();
+        let bvh = Bvh::build(&boxes, 1, 1);
+        for (origin, direction) in [(-5.0, 1.0), (500.0, -1.0)] {
+            let ray = Ray::new(
+                Vec3::new(origin, 0.55, 0.55),
+                Vec3::new(direction, 0.0, 0.0),
+            );
+            let mut met = Vec::new();
+            bvh.traverse(&ray, f64::INFINITY, |items, _| {
+                met.extend_from_slice(items);
+                true
+            });
+            let mut expected: Vec<u32> = (0..300).collect();
+            if direction < 0.0 {
+                expected.reverse();
+            }
+            assert_eq!(met, expected, "direction {direction}");
+            let items = LeafItems::<{ std::mem::size_of::<u32>() }>::at(&bvh.order);
+            let mut any = Vec::new();
+            bvh.traverse_runs_any_order(&ray, f64::INFINITY, items, |run, _| {
+                any.extend(bvh.order[run].iter().copied());
+                true
+            });
+            any.sort();
+            assert_eq!(any, (0..300).collect::<Vec<u32>>(), "direction {direction}");
+        }
     }
 
     #[test]

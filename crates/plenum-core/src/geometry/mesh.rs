@@ -16,7 +16,10 @@ use crate::accel::ray_f32::{gamma_f32, round_up_distance};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::simd::F8;
 use crate::accel::simd::{Avx, Lanes, F4};
-use crate::accel::{bytes_of, Accel, AccelKind, LeafItems, LeafSize, EMBED_LIMIT, EMBED_UNIT, PAD};
+use crate::accel::{
+    bytes_of, Accel, AccelKind, AmongNodes, LeafItems, LeafPlaces, LeafSize, EMBED_LIMIT,
+    EMBED_UNIT, PAD,
+};
 use crate::math::{gamma, Bounds3, Ray, Vec3};
 use std::ops::Range;
 
@@ -472,8 +475,8 @@ impl TriangleMesh {
                     let first = unsafe { origin.add(run.start * EMBED_UNIT) } as *const Block;
                     self.search_leaf::<NEAREST>(first, run.len(), t_max, &mut search)
                 };
-                let items = LeafItems::<EMBED_UNIT>::at(bvh.embedded());
-                traverse_bvh::<NEAREST, _>(bvh, ray, t_max, items, visit_run);
+                let items = AmongNodes;
+                traverse_bvh::<NEAREST>(bvh, ray, t_max, items, visit_run);
             }
             _ => self.search_cells::<NEAREST>(ray, t_max, &mut search),
         }
@@ -494,7 +497,7 @@ impl TriangleMesh {
         match &self.accel {
             Accel::Bvh(bvh) => {
                 let items = LeafItems::<{ std::mem::size_of::<Block>() / LANES }>::at(&self.blocks);
-                traverse_bvh::<NEAREST, _>(bvh, ray, t_max, items, visit_run);
+                traverse_bvh::<NEAREST>(bvh, ray, t_max, items, visit_run);
             }
             Accel::Grid(grid) => grid.traverse_runs(ray, t_max, visit_run),
             Accel::Octree(octree) => octree.traverse_runs(ray, t_max, visit_run),
@@ -958,11 +961,11 @@ fn beyond_error_bound<V: Lanes>(isa: V::Isa, extent: [V; 3], e: [V; 3], det: V, 
 
 /// The BVH's runs for `visit`: nearest first if `NEAREST`, else in any order.
 #[inline(always)]
-fn traverse_bvh<const NEAREST: bool, const STRIDE: usize>(
+fn traverse_bvh<const NEAREST: bool>(
     bvh: &crate::accel::Bvh,
     ray: &Ray,
     t_max: f64,
-    items: LeafItems<STRIDE>,
+    items: impl LeafPlaces,
     visit: impl FnMut(Range<usize>, &mut f64) -> bool,
 ) {
     if NEAREST {
@@ -1342,7 +1345,11 @@ mod tests {
             let hit_source = hit.map(|h| (mesh.source_triangle(h.part), h.t));
             let expected_source = expected.map(|h| (brute.source_triangle(h.part), h.t));
             assert_eq!(hit_source, expected_source, "y = {y}");
-            assert_eq!(mesh.intersect_any(&ray, 1e9).is_some(), hit.is_some(), "y = {y}");
+            assert_eq!(
+                mesh.intersect_any(&ray, 1e9).is_some(),
+                hit.is_some(),
+                "y = {y}"
+            );
         }
     }
 
