@@ -575,60 +575,18 @@ impl TriangleMesh {
     ) -> bool {
         const { assert!(LEAF.max_leaf <= 2 * LANES) };
         debug_assert!(count <= LEAF.max_leaf);
-        match search.axis() {
-            0 => self.search_leaf_along::<0, NEAREST>(avx, first, count, t_max, search),
-            1 => self.search_leaf_along::<1, NEAREST>(avx, first, count, t_max, search),
-            _ => self.search_leaf_along::<2, NEAREST>(avx, first, count, t_max, search),
-        }
-    }
-
-    /// A leaf of one or two blocks, in one test.
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    fn search_leaf_along<const KZ: usize, const NEAREST: bool>(
-        &self,
-        avx: Avx,
-        first: *const Block,
-        count: usize,
-        t_max: &mut f64,
-        search: &mut Search,
-    ) -> bool {
-        let Search {
-            ray,
-            sheared,
-            hit,
-            blocks,
-            ..
-        } = search;
-        let r = sheared.get_or_insert_with(|| ShearedRay::along::<KZ>(ray));
+        let pair = count > LANES;
+        let lanes = if pair { 0xFF } else { 0xF };
+        let avx = Some(avx);
         // SAFETY: a leaf's blocks are stored one after another, and a pair is taken only
         // where the leaf reaches into the second block.
-        let found = unsafe {
-            if count > LANES {
-                let pair = &*(first as *const [Block; 2]);
-                self.intersect_lanes_along::<KZ, NEAREST, F8>(
-                    avx, r, ray, pair, *blocks, 0xFF, *t_max,
-                )
-            } else {
-                self.intersect_lanes_along::<KZ, NEAREST, F4>(
-                    (),
-                    r,
-                    ray,
-                    &*first,
-                    *blocks,
-                    0xF,
-                    *t_max,
-                )
+        unsafe {
+            match search.axis() {
+                0 => self.test_blocks::<0, NEAREST>(avx, first, pair, lanes, t_max, search),
+                1 => self.test_blocks::<1, NEAREST>(avx, first, pair, lanes, t_max, search),
+                _ => self.test_blocks::<2, NEAREST>(avx, first, pair, lanes, t_max, search),
             }
-        };
-        if let Some(h) = found {
-            *hit = Some(h);
-            if !NEAREST {
-                return false;
-            }
-            *t_max = h.t;
         }
-        true
     }
 
     /// The leaf loop testing four triangles at a time.
@@ -690,14 +648,6 @@ impl TriangleMesh {
         t_max: &mut f64,
         search: &mut Search,
     ) -> bool {
-        let Search {
-            ray,
-            sheared,
-            hit,
-            blocks,
-            ..
-        } = search;
-        let r = sheared.get_or_insert_with(|| ShearedRay::along::<KZ>(ray));
         debug_assert!(run.start < LANES && (!PADDED || run.start == 0));
         let skip = run.start % LANES;
         let mut from = !0u32 << skip;
@@ -713,35 +663,71 @@ impl TriangleMesh {
             from = !0;
             // SAFETY: the structure's runs are of stored blocks, one after another, and a
             // pair is taken only where the run reaches into the second block.
-            let found = unsafe {
-                let block = first.add(base / LANES);
-                match avx {
-                    #[cfg(target_arch = "x86_64")]
-                    Some(avx) if pair => {
-                        let pair = &*(block as *const [Block; 2]);
-                        self.intersect_lanes_along::<KZ, NEAREST, F8>(
-                            avx, r, ray, pair, *blocks, lanes, *t_max,
-                        )
-                    }
-                    _ => self.intersect_lanes_along::<KZ, NEAREST, F4>(
-                        (),
-                        r,
-                        ray,
-                        &*block,
-                        *blocks,
-                        lanes,
-                        *t_max,
-                    ),
-                }
-            };
-            if let Some(h) = found {
-                *hit = Some(h);
-                if !NEAREST {
-                    return false;
-                }
-                *t_max = h.t;
+            let block = unsafe { first.add(base / LANES) };
+            if !unsafe { self.test_blocks::<KZ, NEAREST>(avx, block, pair, lanes, t_max, search) } {
+                return false;
             }
             base += width;
+        }
+        true
+    }
+
+    /// One test: of the lanes set in `lanes` of the block at `block`, and of the next block
+    /// too where `pair` (with `avx`). Keeps a hit in `search`, and lowers `t_max` to it if
+    /// `NEAREST`, else returns false.
+    ///
+    /// # Safety
+    /// `block`, and for a pair the block after it, must be stored blocks.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn test_blocks<const KZ: usize, const NEAREST: bool>(
+        &self,
+        avx: Option<Avx>,
+        block: *const Block,
+        pair: bool,
+        lanes: u32,
+        t_max: &mut f64,
+        search: &mut Search,
+    ) -> bool {
+        let Search {
+            ray,
+            sheared,
+            hit,
+            blocks,
+            ..
+        } = search;
+        let r = sheared.get_or_insert_with(|| ShearedRay::along::<KZ>(ray));
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = pair; // Pairs are an AVX test.
+        let found = match avx {
+            #[cfg(target_arch = "x86_64")]
+            Some(avx) if pair => {
+                // SAFETY: for a pair the caller vouches for both blocks.
+                let pair = unsafe { &*(block as *const [Block; 2]) };
+                self.intersect_lanes_along::<KZ, NEAREST, F8>(
+                    avx, r, ray, pair, *blocks, lanes, *t_max,
+                )
+            }
+            _ => {
+                // SAFETY: the caller vouches for the block.
+                let block = unsafe { &*block };
+                self.intersect_lanes_along::<KZ, NEAREST, F4>(
+                    (),
+                    r,
+                    ray,
+                    block,
+                    *blocks,
+                    lanes,
+                    *t_max,
+                )
+            }
+        };
+        if let Some(h) = found {
+            *hit = Some(h);
+            if !NEAREST {
+                return false;
+            }
+            *t_max = h.t;
         }
         true
     }
