@@ -475,8 +475,7 @@ impl TriangleMesh {
                     let first = unsafe { origin.add(run.start * EMBED_UNIT) } as *const Block;
                     self.search_leaf::<NEAREST>(first, run.len(), t_max, &mut search)
                 };
-                let items = AmongNodes;
-                traverse_bvh::<NEAREST>(bvh, ray, t_max, items, visit_run);
+                traverse_bvh::<NEAREST>(bvh, ray, t_max, AmongNodes, visit_run);
             }
             _ => self.search_cells::<NEAREST>(ray, t_max, &mut search),
         }
@@ -679,7 +678,6 @@ impl TriangleMesh {
     /// # Safety
     /// `block`, and for a pair the block after it, must be stored blocks.
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     unsafe fn test_blocks<const KZ: usize, const NEAREST: bool>(
         &self,
         avx: Option<Avx>,
