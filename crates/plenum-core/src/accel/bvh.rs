@@ -569,11 +569,13 @@ impl Bvh {
             if current & LEAF_BIT as usize != 0 {
                 let start = current & START_MASK as usize;
                 let count = (current & !(LEAF_BIT as usize)) >> COUNT_SHIFT;
+                let before = t_max;
                 if !visit(start..start + count, &mut t_max) {
                     return;
                 }
-                if NEAREST_FIRST {
-                    // In any order, `visit` stops instead of lowering `t_max`.
+                // In any order, `visit` stops instead of lowering `t_max`; most leaves
+                // leave it as it was.
+                if NEAREST_FIRST && t_max != before {
                     far = round_up_distance(t_max);
                 }
             } else {

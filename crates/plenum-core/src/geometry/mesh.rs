@@ -470,16 +470,38 @@ impl TriangleMesh {
             Accel::Bvh(bvh) if bvh.is_embedded() => {
                 // A leaf's run starts at its first block's place.
                 let origin = bvh.embedded().as_ptr();
+                // SAFETY (both): a leaf's place is its first block's, within the nodes'
+                // array.
+                let first = move |run: &Range<usize>| unsafe {
+                    origin.add(run.start * EMBED_UNIT) as *const Block
+                };
+                // The instruction set chosen once, not at every leaf.
+                #[cfg(target_arch = "x86_64")]
+                if let Some(avx) = avx {
+                    let state = &mut search;
+                    let visit_run = move |run: Range<usize>, t_max: &mut f64| {
+                        let count = run.end - run.start;
+                        // SAFETY: `avx` says the CPU has AVX.
+                        unsafe {
+                            self.search_leaf_avx::<NEAREST>(avx, first(&run), count, t_max, state)
+                        }
+                    };
+                    traverse_bvh::<NEAREST>(bvh, ray, t_max, AmongNodes, visit_run);
+                    return search.hit;
+                }
                 let visit_run = |run: Range<usize>, t_max: &mut f64| {
-                    // SAFETY: a leaf's place is its first block's, within the nodes' array.
-                    let first = unsafe { origin.add(run.start * EMBED_UNIT) } as *const Block;
-                    self.search_leaf::<NEAREST>(first, run.len(), t_max, &mut search)
+                    let count = run.end - run.start;
+                    let search = &mut search;
+                    self.search_run_sse::<NEAREST, true>(first(&run), 0..count, t_max, search)
                 };
                 traverse_bvh::<NEAREST>(bvh, ray, t_max, AmongNodes, visit_run);
+                search.hit
             }
-            _ => self.search_cells::<NEAREST>(ray, t_max, &mut search),
+            _ => {
+                self.search_cells::<NEAREST>(ray, t_max, &mut search);
+                search.hit
+            }
         }
-        search.hit
     }
 
     /// [`TriangleMesh::search`] through the grid, the octree, brute force or a BVH too large
@@ -539,25 +561,8 @@ impl TriangleMesh {
     /// Tests a BVH leaf of `count` triangles in the blocks from `first` on, as
     /// [`TriangleMesh::search_run`] does a padded run: a leaf holds at most [`LEAF`]'s
     /// `max_leaf` (the build halves a larger run it cannot split by position), two blocks,
-    /// which take one test with AVX and no loop: 3 % fewer instructions per ray than the
-    /// loop over a run's blocks.
-    #[inline(always)]
-    fn search_leaf<const NEAREST: bool>(
-        &self,
-        first: *const Block,
-        count: usize,
-        t_max: &mut f64,
-        search: &mut Search,
-    ) -> bool {
-        #[cfg(target_arch = "x86_64")]
-        if let Some(avx) = search.avx {
-            // SAFETY: `avx` says the CPU has AVX.
-            return unsafe { self.search_leaf_avx::<NEAREST>(avx, first, count, t_max, search) };
-        }
-        self.search_run_sse::<NEAREST, true>(first, 0..count, t_max, search)
-    }
-
-    /// [`TriangleMesh::search_leaf`] in 256-bit instructions.
+    /// which take one test in 256-bit instructions and no loop: 3 % fewer instructions per
+    /// ray than the loop over a run's blocks.
     ///
     /// # Safety
     /// The CPU must support AVX.
@@ -811,22 +816,8 @@ impl TriangleMesh {
                 }
             }
         }
-        let mut on_edge = on_edge;
-        while on_edge != 0 {
-            let lane = on_edge.trailing_zeros() as usize;
-            on_edge &= on_edge - 1;
-            let limit = best.map_or(t_max, |h| h.t);
-            let part = part_of(first_part(), lane);
-            // Read from the block in hand: looking the part up would weigh on every call.
-            let corners = V::corners_of_lane(blocks, lane).map(widened);
-            if let Some((t, b1, b2)) = intersect_triangle(ray, limit, corners) {
-                best = Some(HitRecord {
-                    t,
-                    u: b1,
-                    v: b2,
-                    part,
-                });
-            }
+        if on_edge != 0 {
+            best = settle_on_edge::<V>(ray, blocks, first_part(), on_edge, best, t_max);
         }
         best
     }
@@ -872,6 +863,38 @@ impl TriangleMesh {
             uv,
         }
     }
+}
+
+/// The nearest of `best` and the hits in f64 on the lanes set in `on_edge` of `blocks`,
+/// whose parts start at `first_part`, in (0, t_max): the lanes whose f32 edge function
+/// came out exactly zero. Rare, and apart so that the common path of the block test saves
+/// fewer registers.
+#[cold]
+#[inline(never)]
+fn settle_on_edge<V: BlockLanes>(
+    ray: &Ray,
+    blocks: &V::Blocks,
+    first_part: usize,
+    mut on_edge: u32,
+    mut best: Option<HitRecord>,
+    t_max: f64,
+) -> Option<HitRecord> {
+    while on_edge != 0 {
+        let lane = on_edge.trailing_zeros() as usize;
+        on_edge &= on_edge - 1;
+        let limit = best.map_or(t_max, |h| h.t);
+        // Read from the block in hand: looking the part up would weigh on every call.
+        let corners = V::corners_of_lane(blocks, lane).map(widened);
+        if let Some((t, b1, b2)) = intersect_triangle(ray, limit, corners) {
+            best = Some(HitRecord {
+                t,
+                u: b1,
+                v: b2,
+                part: part_of(first_part, lane),
+            });
+        }
+    }
+    best
 }
 
 /// The edge functions of the watertight test, of the sheared corners `a`, `b`, `c` (x, y):
@@ -1301,7 +1324,7 @@ mod tests {
     fn leaves_the_build_cannot_split_by_position_still_take_one_test() {
         // Twelve triangles about one centroid, each tilted about x by its own angle: no
         // split by position separates them, yet every leaf must fit the one test of
-        // `search_leaf`; rays off the centroid meet them at different distances.
+        // `search_leaf_avx`; rays off the centroid meet them at different distances.
         let count = 12;
         let mut positions = Vec::new();
         let mut triangles = Vec::new();
