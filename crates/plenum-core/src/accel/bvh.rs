@@ -40,22 +40,49 @@ const TRAVERSAL_COST: f32 = 1.0;
 /// Subtrees with more items than this are built in parallel.
 const PARALLEL_ITEMS: usize = 4096;
 
-/// A child reference: an interior node's byte offset in the nodes (its index times
-/// [`NODE_BYTES`], so that the traversal adds it to the base without a shift), or a leaf (top
-/// bit set) with its item run.
-const LEAF_BIT: u32 = 1 << 31;
+/// A child reference. An interior node: its byte offset in the nodes (a multiple of 64, so
+/// that the traversal adds it to the base without a shift). A leaf: `LEAF_FLAG` set, its
+/// run's first position above `START_SHIFT` and its count less one below the flag. After
+/// [`Bvh::embed_blocks`] a leaf's start counts [`EMBED_UNIT`]s, so that its reference is its
+/// first block's byte offset plus at most 15, on the same cache line: a prefetch reads
+/// either kind from the base plus the reference, without decoding it.
+const LEAF_FLAG: u32 = 8;
+const START_SHIFT: u32 = 4;
 const NODE_BYTES: u32 = std::mem::size_of::<Node>() as u32;
-const COUNT_SHIFT: u32 = 27;
-const START_MASK: u32 = (1 << COUNT_SHIFT) - 1;
-/// Longest run a leaf can hold.
-const MAX_LEAF_ITEMS: usize = 15;
-const EMPTY: u32 = LEAF_BIT;
+/// Longest run a leaf can hold: its count less one takes the bits below the flag.
+const MAX_LEAF_ITEMS: usize = LEAF_FLAG as usize;
+/// Never read: `used` leaves the slot out.
+const EMPTY: u32 = LEAF_FLAG;
 /// The unit in which [`Bvh::embed_blocks`] gives a leaf's place: blocks are a whole number
 /// of them, so every block starts on one.
-pub const EMBED_UNIT: usize = 16;
-/// The most bytes [`Bvh::embed_blocks`] lays out: interior references are byte offsets
-/// below [`LEAF_BIT`], and a leaf's place below `(START_MASK + 1) * EMBED_UNIT`, both 2 GiB.
-pub const EMBED_LIMIT: usize = LEAF_BIT as usize;
+pub const EMBED_UNIT: usize = 1 << START_SHIFT;
+/// The most bytes [`Bvh::embed_blocks`] lays out, within what references reach (4 GiB).
+pub const EMBED_LIMIT: usize = 1 << 31;
+
+/// The reference of a leaf holding the run of `count` items from `start`.
+fn leaf_reference(start: usize, count: usize) -> u32 {
+    assert!(
+        (1..=MAX_LEAF_ITEMS).contains(&count),
+        "a BVH leaf of {count} items"
+    );
+    assert!(
+        start < 1 << (32 - START_SHIFT),
+        "too many items for a BVH leaf reference"
+    );
+    ((start as u32) << START_SHIFT) | LEAF_FLAG | (count as u32 - 1)
+}
+
+#[inline(always)]
+fn is_leaf(reference: u32) -> bool {
+    reference & LEAF_FLAG != 0
+}
+
+/// A leaf reference's run: its start and its count.
+#[inline(always)]
+fn leaf_run(reference: u32) -> (usize, usize) {
+    let count = (reference & (LEAF_FLAG - 1)) as usize + 1;
+    ((reference >> START_SHIFT) as usize, count)
+}
 
 /// Eight child boxes as six planes of eight lanes: min x, y, z then max x, y, z. Four cache
 /// lines exactly.
@@ -287,19 +314,14 @@ impl Bvh {
     /// Asks for a child the traversal will visit later, so it arrives while others are
     /// tested: five cache lines from its start, a node's four and the first of the blocks
     /// stored after it, or a leaf's first five (a mesh's two blocks of four triangles, 320
-    /// bytes, where the leaf follows its node directly). Without branches: whether a child is
-    /// a leaf is a coin toss to the branch predictor.
+    /// bytes, where the leaf follows its node directly). Without branches (see
+    /// [`LeafPlaces::fetch_address`]): whether a child is a leaf is a coin toss to the branch
+    /// predictor.
     #[inline(always)]
     fn prefetch(&self, child: u32, items: impl LeafPlaces) {
         #[cfg(target_arch = "x86_64")]
         {
-            let is_node = child & LEAF_BIT == 0;
-            let node = (self.nodes.as_ptr() as *const i8).wrapping_add(child as usize);
-            let leaf = items.leaf(
-                self.nodes.as_ptr() as *const u8,
-                (child & START_MASK) as usize,
-            ) as *const i8;
-            let p = std::hint::select_unpredictable(is_node, node, leaf);
+            let p = items.fetch_address(self.nodes.as_ptr() as *const u8, child) as *const i8;
             // SAFETY: prefetching is only a hint; it never faults, so the address needs no
             // bounds check.
             unsafe {
@@ -335,23 +357,17 @@ impl Bvh {
         let mut leaves: Vec<(u32, usize, usize)> = Vec::new(); // (reference, node, slot)
         for (n, node) in self.nodes.iter().enumerate() {
             for (slot, &child) in node.children.iter().enumerate() {
-                if node.used & (1 << slot) != 0 && child & LEAF_BIT != 0 {
+                if node.used & (1 << slot) != 0 && is_leaf(child) {
                     leaves.push((child, n, slot));
                 }
             }
         }
-        leaves.sort_unstable_by_key(|&(child, _, _)| child & START_MASK);
+        leaves.sort_unstable_by_key(|&(child, _, _)| leaf_run(child).0);
         let mut padded = Vec::with_capacity(order.len() + leaves.len() * (block - 1));
         for (child, n, slot) in leaves {
-            let start = (child & START_MASK) as usize;
-            let count = ((child & !LEAF_BIT) >> COUNT_SHIFT) as usize;
-            let new_start = padded.len() as u32;
-            assert!(
-                new_start <= START_MASK,
-                "too many items for a BVH leaf reference"
-            );
+            let (start, count) = leaf_run(child);
+            self.nodes[n].children[slot] = leaf_reference(padded.len(), count);
             append_padded(&mut padded, &order[start..start + count], block);
-            self.nodes[n].children[slot] = LEAF_BIT | ((count as u32) << COUNT_SHIFT) | new_start;
         }
         padded
     }
@@ -412,19 +428,16 @@ impl Bvh {
         let original = self.nodes[index];
         let mut node = original;
         let used = |slot: usize| original.used & (1 << slot) != 0;
-        let is_leaf = |slot: usize| original.children[slot] & LEAF_BIT != 0;
-        for slot in (0..WIDTH).filter(|&s| used(s) && is_leaf(s)) {
-            let child = original.children[slot];
-            let start = (child & START_MASK) as usize;
-            let count = (child & !LEAF_BIT) >> COUNT_SHIFT;
+        let leaf = |slot: usize| is_leaf(original.children[slot]);
+        for slot in (0..WIDTH).filter(|&s| used(s) && leaf(s)) {
+            let (start, count) = leaf_run(original.children[slot]);
             let first = start / layout.lanes * layout.block_bytes;
-            let end = first + (count as usize).div_ceil(layout.lanes) * layout.block_bytes;
+            let end = first + count.div_ceil(layout.lanes) * layout.block_bytes;
             let place = arena.take(EMBED_UNIT, end - first);
             arena.put(place, &layout.blocks[first..end]);
-            let place = place / EMBED_UNIT;
-            node.children[slot] = LEAF_BIT | (count << COUNT_SHIFT) | place as u32;
+            node.children[slot] = leaf_reference(place / EMBED_UNIT, count);
         }
-        for slot in (0..WIDTH).filter(|&s| used(s) && !is_leaf(s)) {
+        for slot in (0..WIDTH).filter(|&s| used(s) && !leaf(s)) {
             let child = original.children[slot] / NODE_BYTES;
             node.children[slot] = self.embed_node(child as usize, layout, arena);
         }
@@ -437,7 +450,7 @@ impl Bvh {
         bytes_of(&self.nodes)
     }
 
-    /// The node whose reference is `offset` (see [`LEAF_BIT`]).
+    /// The node whose reference is `offset` (see [`LEAF_FLAG`]).
     #[inline(always)]
     fn node_at(&self, offset: usize) -> &Node {
         debug_assert!(offset.is_multiple_of(std::mem::align_of::<Node>()));
@@ -465,9 +478,8 @@ impl Bvh {
             let node = self.node_at(reference as usize);
             for slot in (0..WIDTH).filter(|&s| node.used & (1 << s) != 0) {
                 let child = node.children[slot];
-                if child & LEAF_BIT != 0 {
-                    let count = (child & !LEAF_BIT) >> COUNT_SHIFT;
-                    leaves.push(((child & START_MASK) as usize, count as usize));
+                if is_leaf(child) {
+                    leaves.push(leaf_run(child));
                 } else {
                     pending.push(child);
                 }
@@ -566,9 +578,8 @@ impl Bvh {
         // before every use as an offset.
         let mut current = 0usize;
         loop {
-            if current & LEAF_BIT as usize != 0 {
-                let start = current & START_MASK as usize;
-                let count = (current & !(LEAF_BIT as usize)) >> COUNT_SHIFT;
+            if is_leaf(current as u32) {
+                let (start, count) = leaf_run(current as u32);
                 let before = t_max;
                 if !visit(start..start + count, &mut t_max) {
                     return;
@@ -729,22 +740,25 @@ pub struct AmongNodes;
 
 /// Where a leaf's items lie, for prefetching: [`LeafItems`] or [`AmongNodes`].
 pub trait LeafPlaces: Copy {
-    /// The address of the items of a run starting at `start`, for a BVH whose nodes are
-    /// at `nodes`.
-    fn leaf(self, nodes: *const u8, start: usize) -> *const u8;
+    /// Where child `reference` of a BVH whose nodes are at `nodes` starts, or an address
+    /// on the same cache line: its node, or its leaf's items.
+    fn fetch_address(self, nodes: *const u8, reference: u32) -> *const u8;
 }
 
 impl<const STRIDE: usize> LeafPlaces for LeafItems<STRIDE> {
     #[inline(always)]
-    fn leaf(self, _: *const u8, start: usize) -> *const u8 {
-        self.base.wrapping_add(start * STRIDE)
+    fn fetch_address(self, nodes: *const u8, reference: u32) -> *const u8 {
+        let node = nodes.wrapping_add(reference as usize);
+        let leaf = self.base.wrapping_add(leaf_run(reference).0 * STRIDE);
+        std::hint::select_unpredictable(is_leaf(reference), leaf, node)
     }
 }
 
 impl LeafPlaces for AmongNodes {
+    /// The reference itself: see [`LEAF_FLAG`].
     #[inline(always)]
-    fn leaf(self, nodes: *const u8, start: usize) -> *const u8 {
-        nodes.wrapping_add(start * EMBED_UNIT)
+    fn fetch_address(self, nodes: *const u8, reference: u32) -> *const u8 {
+        nodes.wrapping_add(reference as usize)
     }
 }
 
@@ -753,7 +767,7 @@ impl LeafPlaces for AmongNodes {
 fn flatten_children(nodes: &mut Vec<Node>, children: &[BuildNode]) -> u32 {
     let index = nodes.len();
     assert!(
-        index < (LEAF_BIT / NODE_BYTES) as usize,
+        index < (u32::MAX / NODE_BYTES) as usize,
         "too many nodes for a BVH node reference"
     );
     let mut node = Node {
@@ -778,7 +792,7 @@ fn flatten_children(nodes: &mut Vec<Node>, children: &[BuildNode]) -> u32 {
     nodes.push(node);
     for (slot, child) in children.iter().enumerate() {
         let reference = match child {
-            BuildNode::Leaf { start, count, .. } => LEAF_BIT | (count << COUNT_SHIFT) | start,
+            BuildNode::Leaf { start, count, .. } => leaf_reference(*start as usize, *count as usize),
             BuildNode::Inner { children, .. } => flatten_children(nodes, children),
         };
         nodes[index].children[slot] = reference;
@@ -1042,11 +1056,10 @@ mod tests {
         let mut covered = vec![false; order.len()];
         for node in bvh.nodes.iter() {
             for (slot, &child) in node.children.iter().enumerate() {
-                if node.used & (1 << slot) == 0 || child & LEAF_BIT == 0 {
+                if node.used & (1 << slot) == 0 || !is_leaf(child) {
                     continue;
                 }
-                let start = (child & START_MASK) as usize;
-                let count = ((child & !LEAF_BIT) >> COUNT_SHIFT) as usize;
+                let (start, count) = leaf_run(child);
                 assert_eq!(start % 4, 0, "a leaf starts inside a block");
                 for (k, &item) in order[start..start + count.next_multiple_of(4)]
                     .iter()
@@ -1096,12 +1109,11 @@ mod tests {
             let mut next = at + NODE_BYTES as usize;
             for slot in (0..WIDTH).filter(|&s| node.used & (1 << s) != 0) {
                 let child = node.children[slot];
-                if child & LEAF_BIT == 0 {
+                if !is_leaf(child) {
                     pending.push(child as usize);
                     continue;
                 }
-                let place = (child & START_MASK) as usize;
-                let count = ((child & !LEAF_BIT) >> COUNT_SHIFT) as usize;
+                let (place, count) = leaf_run(child);
                 assert_eq!(
                     place * EMBED_UNIT,
                     next,
