@@ -792,7 +792,9 @@ fn flatten_children(nodes: &mut Vec<Node>, children: &[BuildNode]) -> u32 {
     nodes.push(node);
     for (slot, child) in children.iter().enumerate() {
         let reference = match child {
-            BuildNode::Leaf { start, count, .. } => leaf_reference(*start as usize, *count as usize),
+            BuildNode::Leaf { start, count, .. } => {
+                leaf_reference(*start as usize, *count as usize)
+            }
             BuildNode::Inner { children, .. } => flatten_children(nodes, children),
         };
         nodes[index].children[slot] = reference;
@@ -1082,6 +1084,23 @@ mod tests {
     }
 
     #[test]
+    fn leaf_references_keep_their_run_apart_from_node_references() {
+        for count in 1..=MAX_LEAF_ITEMS {
+            for start in [0, 1, 5, 4096, (1 << (32 - START_SHIFT)) - 1] {
+                let reference = leaf_reference(start, count);
+                assert!(is_leaf(reference));
+                assert_eq!(leaf_run(reference), (start, count));
+            }
+        }
+        // Nodes start on cache lines: their offsets never carry the flag.
+        for index in [0, 1, 7, 1 << 20] {
+            assert!(!is_leaf(index * NODE_BYTES));
+        }
+        assert!(std::panic::catch_unwind(|| leaf_reference(0, MAX_LEAF_ITEMS + 1)).is_err());
+        assert!(std::panic::catch_unwind(|| leaf_reference(1 << 28, 1)).is_err());
+    }
+
+    #[test]
     fn embedded_blocks_follow_their_node_and_are_visited_as_before() {
         use crate::math::Vec3;
         let boxes = curve_boxes();
@@ -1118,6 +1137,12 @@ mod tests {
                     place * EMBED_UNIT,
                     next,
                     "a leaf's blocks away from its node"
+                );
+                // Read as a byte offset from the base (on a cache line's start), the
+                // reference names the line the leaf's first block starts on.
+                assert_eq!(
+                    AmongNodes.fetch_address(std::ptr::null(), child) as usize / 64,
+                    place * EMBED_UNIT / 64
                 );
                 next += count.div_ceil(4) * EMBED_UNIT;
                 let items = items_at(place, count);
