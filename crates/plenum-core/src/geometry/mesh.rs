@@ -459,45 +459,44 @@ impl TriangleMesh {
         t_max: f64,
         avx: Option<Avx>,
     ) -> Option<HitRecord> {
-        let mut search = Search {
+        let start = |blocks: &[u8]| Search {
             ray,
             sheared: None,
             hit: None,
             avx,
-            blocks: self.block_bytes().as_ptr(),
+            blocks: blocks.as_ptr(),
         };
         match &self.accel {
             Accel::Bvh(bvh) if bvh.is_embedded() => {
-                // A leaf's run starts at its first block's place.
-                let origin = bvh.embedded().as_ptr();
-                // SAFETY (both): a leaf's place is its first block's, within the nodes'
-                // array.
-                let first = move |run: &Range<usize>| unsafe {
-                    origin.add(run.start * EMBED_UNIT) as *const Block
+                let mut search = start(bvh.embedded());
+                // A leaf's run starts at its first block's place, counted from the start of
+                // the nodes' array, where the search counts places from: the closures then
+                // hold two references, which travel in registers.
+                // SAFETY (both): the place lies within the nodes' array.
+                let first = |search: &Search, run: &Range<usize>| unsafe {
+                    search.blocks.add(run.start * EMBED_UNIT) as *const Block
                 };
                 // The instruction set chosen once, not at every leaf.
                 #[cfg(target_arch = "x86_64")]
                 if let Some(avx) = avx {
                     let state = &mut search;
                     let visit_run = move |run: Range<usize>, t_max: &mut f64| {
-                        let count = run.end - run.start;
+                        let (block, count) = (first(state, &run), run.end - run.start);
                         // SAFETY: `avx` says the CPU has AVX.
-                        unsafe {
-                            self.search_leaf_avx::<NEAREST>(avx, first(&run), count, t_max, state)
-                        }
+                        unsafe { self.search_leaf_avx::<NEAREST>(avx, block, count, t_max, state) }
                     };
                     traverse_bvh::<NEAREST>(bvh, ray, t_max, AmongNodes, visit_run);
                     return search.hit;
                 }
                 let visit_run = |run: Range<usize>, t_max: &mut f64| {
-                    let count = run.end - run.start;
-                    let search = &mut search;
-                    self.search_run_sse::<NEAREST, true>(first(&run), 0..count, t_max, search)
+                    let (block, count) = (first(&search, &run), run.end - run.start);
+                    self.search_run_sse::<NEAREST, true>(block, 0..count, t_max, &mut search)
                 };
                 traverse_bvh::<NEAREST>(bvh, ray, t_max, AmongNodes, visit_run);
                 search.hit
             }
             _ => {
+                let mut search = start(self.block_bytes());
                 self.search_cells::<NEAREST>(ray, t_max, &mut search);
                 search.hit
             }
