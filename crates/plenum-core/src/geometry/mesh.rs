@@ -496,7 +496,8 @@ impl TriangleMesh {
                 search.hit
             }
             _ => {
-                let mut search = start(self.block_bytes());
+                // Not among nodes: the blocks are the mesh's own.
+                let mut search = start(bytes_of(&self.blocks));
                 self.search_cells::<NEAREST>(ray, t_max, &mut search);
                 search.hit
             }
