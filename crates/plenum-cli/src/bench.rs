@@ -5,7 +5,7 @@
 //! the two compared pass by pass and hit by hit.
 
 use clap::Args;
-use plenum_core::accel::AccelKind;
+use plenum_core::accel::{AccelKind, SahCost};
 use plenum_core::geometry::TriangleMesh;
 use plenum_core::math::{Ray, Vec3};
 use plenum_core::scene::Scene;
@@ -113,6 +113,14 @@ impl Target {
             Target::Scene(s) => s.primitives.len(),
             #[cfg(feature = "embree")]
             Target::Embree(e) => e.triangle_count(),
+        }
+    }
+
+    /// The tree's cost per ray, where the structure is a BVH of Plenum's.
+    fn sah_cost(&self) -> Option<SahCost> {
+        match self {
+            Target::Mesh(m) => m.sah_cost(),
+            _ => None,
         }
     }
 
@@ -392,6 +400,7 @@ impl Measured<'_> {
             build_mprims_per_s: prims as f64 / self.build_seconds.max(1e-12) / 1e6,
             memory_bytes: memory,
             bytes_per_primitive: memory as f64 / prims.max(1) as f64,
+            sah_cost: self.target.sah_cost(),
             rays: self.hits.len(),
             closest_mrays_per_s: n / closest.max(1e-12) / 1e6,
             closest_ms: closest * 1e3,
@@ -538,6 +547,7 @@ struct Report {
     build_mprims_per_s: f64,
     memory_bytes: usize,
     bytes_per_primitive: f64,
+    sah_cost: Option<SahCost>,
     rays: usize,
     closest_mrays_per_s: f64,
     closest_ms: f64,
@@ -558,6 +568,11 @@ impl Report {
             "build_mprims_per_s": self.build_mprims_per_s,
             "memory_bytes": self.memory_bytes,
             "bytes_per_primitive": self.bytes_per_primitive,
+            "sah_cost": self.sah_cost.map(|c| serde_json::json!({
+                "total": c.nodes + c.leaves,
+                "nodes": c.nodes,
+                "leaf_blocks": c.leaves,
+            })),
             "rays": self.rays,
             "closest_mrays_per_s": self.closest_mrays_per_s,
             "closest_ms": self.closest_ms,
@@ -596,6 +611,15 @@ impl Report {
             "build: {:.1} ms ({:.2} Mprims/s); {memory}",
             self.build_ms, self.build_mprims_per_s
         );
+        if let Some(c) = self.sah_cost {
+            // As Embree's statistics (verbose=2) give it, for comparison.
+            println!(
+                "tree: SAH cost {:.3} ({:.3} nodes + {:.3} leaf blocks of four per ray)",
+                c.nodes + c.leaves,
+                c.nodes,
+                c.leaves
+            );
+        }
     }
 
     fn print_speeds(&self) {

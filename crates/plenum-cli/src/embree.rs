@@ -100,7 +100,11 @@ impl EmbreeMesh {
     /// Builds Embree's BVH over the mesh's triangles, in the order the mesh was made from (so
     /// hits name triangles as the mesh file does), with `threads` build threads.
     pub fn build(mesh: &TriangleMesh, threads: usize) -> Result<EmbreeMesh, String> {
-        let config = CString::new(format!("threads={threads}")).map_err(|e| e.to_string())?;
+        // PLENUM_EMBREE_CONFIG adds to Embree's device configuration: ",verbose=2" prints
+        // its builder's statistics, whose SAH cost `plenum bench` gives for Plenum's BVH.
+        let extra = std::env::var("PLENUM_EMBREE_CONFIG").unwrap_or_default();
+        let config =
+            CString::new(format!("threads={threads}{extra}")).map_err(|e| e.to_string())?;
         // SAFETY: plain calls into the Embree C API with the buffers it hands out, sized as
         // asked; every handle is checked before use and released once.
         unsafe {

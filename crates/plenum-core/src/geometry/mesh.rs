@@ -17,7 +17,7 @@ use crate::accel::ray_f32::{gamma_f32, round_up_distance};
 use crate::accel::simd::F8;
 use crate::accel::simd::{Avx, Lanes, F4};
 use crate::accel::{
-    bytes_of, Accel, AccelKind, AmongNodes, LeafItems, LeafPlaces, LeafSize, EMBED_LIMIT,
+    bytes_of, Accel, AccelKind, AmongNodes, LeafItems, LeafPlaces, LeafSize, SahCost, EMBED_LIMIT,
     EMBED_UNIT, PAD,
 };
 use crate::math::{gamma, Bounds3, Ray, Vec3};
@@ -331,6 +331,15 @@ impl TriangleMesh {
             + self.normals.len() * std::mem::size_of::<Vec3>()
             + self.uvs.len() * std::mem::size_of::<[f64; 2]>()
             + self.accel.memory_bytes()
+    }
+
+    /// The BVH's expected cost per ray, in blocks of four triangles; None for another
+    /// structure.
+    pub fn sah_cost(&self) -> Option<SahCost> {
+        match &self.accel {
+            Accel::Bvh(bvh) => Some(bvh.sah_cost(LANES)),
+            _ => None,
+        }
     }
 
     pub fn is_closed(&self) -> bool {
