@@ -10,7 +10,7 @@
 
 use super::mailbox::{new_owner, Mailbox};
 use super::pages::LargeArray;
-use super::{append_padded, nearest, split_off_large};
+use super::{append_padded, nearest, split_off_large, Reaches};
 use crate::math::{Bounds3, Ray, Vec3};
 use std::ops::Range;
 
@@ -50,8 +50,8 @@ pub struct Grid {
 
 impl Grid {
     /// A grid over items given by their bounds, for a caller that tests `block` items at a
-    /// time.
-    pub fn build(item_bounds: &[Bounds3], block: usize) -> Grid {
+    /// time; with `reaches`, an item is filed only in the cells it may reach into.
+    pub fn build(item_bounds: &[Bounds3], block: usize, reaches: Option<Reaches>) -> Grid {
         let lambda = if block > 1 { LAMBDA_BLOCKS } else { LAMBDA };
         let (bounded, large) = split_off_large(item_bounds);
         let union = |items: &[u32]| {
@@ -110,9 +110,33 @@ impl Grid {
         // arithmetic can never leave an item out of a cell the ray meets it in.
         let margin = longest * 1e-9;
         let filed = |i: u32| item_bounds[i as usize].expanded(margin);
+        // Asked of a cell grown as the item's box is, and by a little of its size more,
+        // so that the finer test's own rounding never leaves an item out either.
+        let pad = margin + 1e-6 * grid.cell_size.max_component();
+        let kept = |i: u32, box_cells: &Bounds3, cell: [usize; 3]| match reaches {
+            Some(reaches) if !grid.one_cell(box_cells) => {
+                reaches(i, &grid.cell_bounds(cell).expanded(pad))
+            }
+            _ => true,
+        };
+        // Each item's cells, by its box and then by `reaches`; listed once, filed twice.
+        let cells_of = |i: u32| {
+            let b = filed(i);
+            let mut cells = Vec::new();
+            grid.for_cells(&b, |c, cell| {
+                if kept(i, &b, cell) {
+                    cells.push(c)
+                }
+            });
+            cells
+        };
+        let item_cells: Vec<Vec<usize>> = {
+            use rayon::prelude::*;
+            bounded.par_iter().map(|&i| cells_of(i)).collect()
+        };
         let mut counts = vec![0u32; cell_count + 1];
-        for &i in &bounded {
-            grid.for_cells(&filed(i), |c| counts[c] += 1);
+        for &c in item_cells.iter().flatten() {
+            counts[c] += 1;
         }
         let mut total = 0u32;
         for c in counts.iter_mut() {
@@ -122,11 +146,11 @@ impl Grid {
         }
         let mut fill = counts.clone();
         let mut items = vec![0u32; total as usize];
-        for &i in &bounded {
-            grid.for_cells(&filed(i), |c| {
+        for (&i, cells) in bounded.iter().zip(&item_cells) {
+            for &c in cells {
                 items[fill[c] as usize] = i;
                 fill[c] += 1;
-            });
+            }
         }
         grid.macro_resolution = grid.resolution.map(|r| r.div_ceil(MACRO));
         let [mx, my, mz] = grid.macro_resolution;
@@ -164,17 +188,35 @@ impl Grid {
         (c.min(MAX_RESOLUTION as f64) as i64).clamp(0, self.resolution[axis] as i64 - 1) as usize
     }
 
-    fn for_cells(&self, b: &Bounds3, mut f: impl FnMut(usize)) {
+    /// Hands `f` each cell the box `b` meets: its index and its coordinates.
+    fn for_cells(&self, b: &Bounds3, mut f: impl FnMut(usize, [usize; 3])) {
         let lo = [0, 1, 2].map(|a| self.cell_of(b.min[a], a));
         let hi = [0, 1, 2].map(|a| self.cell_of(b.max[a], a));
         let [nx, ny, _] = self.resolution;
         for z in lo[2]..=hi[2] {
             for y in lo[1]..=hi[1] {
                 for x in lo[0]..=hi[0] {
-                    f((z * ny + y) * nx + x);
+                    f((z * ny + y) * nx + x, [x, y, z]);
                 }
             }
         }
+    }
+
+    /// Whether the box `b` lies in one cell.
+    fn one_cell(&self, b: &Bounds3) -> bool {
+        (0..3).all(|a| self.cell_of(b.min[a], a) == self.cell_of(b.max[a], a))
+    }
+
+    /// The box of the cell at `cell`.
+    fn cell_bounds(&self, cell: [usize; 3]) -> Bounds3 {
+        let corner = |c: [usize; 3]| {
+            Vec3::new(
+                self.bounds.min.x + c[0] as f64 * self.cell_size.x,
+                self.bounds.min.y + c[1] as f64 * self.cell_size.y,
+                self.bounds.min.z + c[2] as f64 * self.cell_size.z,
+            )
+        };
+        Bounds3::new(corner(cell), corner(cell.map(|c| c + 1)))
     }
 
     /// Visits the cells the ray crosses in order, handing `visit` the untested items of each

@@ -121,6 +121,12 @@ impl LeafSize {
     };
 }
 
+/// For the structures that file items in cells (the grid and the octree), a finer test
+/// than an item's box: whether item `i` may reach into a cell's box. It must never say no
+/// where the item does reach in (a triangle's exact test against the box, say); a cell
+/// kept for an item that misses it costs only a test.
+pub type Reaches<'a> = &'a (dyn Fn(u32, &Bounds3) -> bool + Sync);
+
 #[derive(Clone, Debug)]
 pub enum Accel {
     Bvh(Bvh),
@@ -139,10 +145,21 @@ impl Accel {
     /// Builds a `kind` structure over items given by their bounds (empty boxes are never
     /// returned by traversal).
     pub fn build(kind: AccelKind, item_bounds: &[Bounds3], leaf: LeafSize) -> Accel {
+        Accel::build_with(kind, item_bounds, leaf, None)
+    }
+
+    /// [`Accel::build`], with the grid and the octree filing an item only in the cells
+    /// that `reaches` says it may reach into, not in every cell its box meets.
+    pub fn build_with(
+        kind: AccelKind,
+        item_bounds: &[Bounds3],
+        leaf: LeafSize,
+        reaches: Option<Reaches>,
+    ) -> Accel {
         match kind {
             AccelKind::Bvh => Accel::Bvh(Bvh::build(item_bounds, leaf.max_leaf, leaf.block)),
-            AccelKind::Grid => Accel::Grid(Grid::build(item_bounds, leaf.block)),
-            AccelKind::Octree => Accel::Octree(Octree::build(item_bounds, leaf.block)),
+            AccelKind::Grid => Accel::Grid(Grid::build(item_bounds, leaf.block, reaches)),
+            AccelKind::Octree => Accel::Octree(Octree::build(item_bounds, leaf.block, reaches)),
             AccelKind::None => Accel::None(BruteForce::build(item_bounds)),
         }
     }

@@ -6,7 +6,7 @@
 //! visited front to back. Items filed in several cells are mailboxed.
 
 use super::mailbox::{new_owner, Mailbox};
-use super::{append_padded, nearest, split_off_large};
+use super::{append_padded, nearest, split_off_large, Reaches};
 use crate::math::{Bounds3, Ray, Vec3};
 use std::mem::MaybeUninit;
 use std::ops::Range;
@@ -21,9 +21,12 @@ struct Splitting {
     split_cost: usize,
 }
 
-/// What a build files items by: their slightly grown boxes, and when to split a cell.
+/// What a build files items by: their boxes grown by `margin`, the finer test where there
+/// is one, and when to split a cell.
 struct Filing<'a> {
     boxes: &'a [Bounds3],
+    margin: f64,
+    reaches: Option<Reaches<'a>>,
     splitting: Splitting,
 }
 
@@ -105,8 +108,8 @@ fn child_box(lo: Vec3, hi: Vec3, octant: usize) -> (Vec3, Vec3) {
 
 impl Octree {
     /// An octree over items given by their bounds, for a caller that tests `block` items
-    /// at a time.
-    pub fn build(item_bounds: &[Bounds3], block: usize) -> Octree {
+    /// at a time; with `reaches`, an item is filed only in the cells it may reach into.
+    pub fn build(item_bounds: &[Bounds3], block: usize, reaches: Option<Reaches>) -> Octree {
         let splitting = if block > 1 { IN_BLOCKS } else { ONE_BY_ONE };
         let (bounded, large) = split_off_large(item_bounds);
         let union = |items: &[u32]| {
@@ -136,6 +139,8 @@ impl Octree {
         let (lo, hi) = (tree.bounds.min, tree.bounds.max);
         let filing = Filing {
             boxes: &filed,
+            margin,
+            reaches,
             splitting,
         };
         tree.build_node(0, lo, hi, bounded, 0, &filing);
@@ -167,6 +172,8 @@ impl Octree {
         let mut children: [Vec<u32>; 8] = Default::default();
         for &i in &items {
             let b = &filing.boxes[i as usize];
+            // Octants the box reaches into, and the axes along which it crosses the middle.
+            let straddles = (0..3).any(|a| b.min[a] <= mid[a] && b.max[a] >= mid[a]);
             for (octant, list) in children.iter_mut().enumerate() {
                 let inside = (0..3).all(|a| {
                     if octant >> a & 1 == 1 {
@@ -175,7 +182,17 @@ impl Octree {
                         b.min[a] <= mid[a]
                     }
                 });
-                if inside {
+                // Where the box lies in one octant, the item reaches into it.
+                let kept = match filing.reaches {
+                    Some(reaches) if inside && straddles => {
+                        // Asked of the cell grown as the grid grows its cells (see there).
+                        let (clo, chi) = child_box(lo, hi, octant);
+                        let pad = filing.margin + 1e-6 * (chi - clo).max_component();
+                        reaches(i, &Bounds3::new(clo, chi).expanded(pad))
+                    }
+                    _ => inside,
+                };
+                if kept {
                     list.push(i);
                 }
             }
@@ -479,7 +496,7 @@ mod tests {
             let c = Vec3::new((k & 1) as f64, (k >> 1 & 1) as f64, (k >> 2 & 1) as f64);
             boxes.push(Bounds3::new(c - Vec3::splat(0.01), c + Vec3::splat(0.01)));
         }
-        let tree = Octree::build(&boxes, 1);
+        let tree = Octree::build(&boxes, 1, None);
         assert_eq!(depth(&tree, 0), MAX_DEPTH);
         let mut directions = Vec::new();
         for sign in [-1.0, 1.0] {
