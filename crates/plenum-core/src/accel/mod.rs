@@ -258,6 +258,47 @@ mod tests {
     }
 
     #[test]
+    fn cells_filed_by_the_finer_test_hold_fewer_items_and_keep_those_reached() {
+        use crate::sampling::Rng;
+        // Small triangles spread through the unit cube make the cells small; slivers along
+        // its diagonal have boxes that cover many cells the slivers themselves miss.
+        let mut rng = Rng::new(11, 0);
+        let mut triangles: Vec<[Vec3; 3]> = (0..400)
+            .map(|_| {
+                let c = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform());
+                [c, c + Vec3::X * 0.02, c + Vec3::Y * 0.02]
+            })
+            .collect();
+        for k in 0..10 {
+            let shift = Vec3::new(0.0, 0.0, k as f64 * 0.05);
+            let (a, b) = (Vec3::ZERO + shift, Vec3::ONE * 0.7 + shift);
+            triangles.push([a, b, b + Vec3::new(0.01, -0.01, 0.0)]);
+        }
+        let bounds: Vec<Bounds3> = triangles.iter().map(|t| Bounds3::from_points(*t)).collect();
+        let reaches = |i: u32, cell: &Bounds3| cell.meets_triangle(triangles[i as usize]);
+        for kind in [AccelKind::Grid, AccelKind::Octree] {
+            let by_box = Accel::build(kind, &bounds, LeafSize::SINGLE);
+            let finer = Accel::build_with(kind, &bounds, LeafSize::SINGLE, Some(&reaches));
+            let (coarse, fine) = (by_box.memory_bytes(), finer.memory_bytes());
+            assert!(fine < coarse, "{kind:?}: {fine} bytes against {coarse}");
+            // A ray through a point of a triangle is handed that triangle.
+            for (i, t) in triangles.iter().enumerate() {
+                for (u, v) in [(0.2, 0.2), (0.6, 0.3), (0.05, 0.9)] {
+                    let p = t[0] + (t[1] - t[0]) * u + (t[2] - t[0]) * v * (1.0 - u);
+                    let d = Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, 1.0);
+                    let ray = Ray::new(p - d * 3.0, d);
+                    let mut handed = false;
+                    finer.traverse(&ray, f64::INFINITY, |items, _| {
+                        handed |= items.contains(&(i as u32));
+                        true
+                    });
+                    assert!(handed, "{kind:?}: triangle {i} not handed at {p:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn nearest_names_an_axis_of_the_smallest_time() {
         let values = [0.0, 1.0, 2.0, f64::INFINITY];
         for &x in &values {
