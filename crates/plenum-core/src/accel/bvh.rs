@@ -95,6 +95,21 @@ struct Node {
     used: u32,
 }
 
+impl Node {
+    /// The slots in use.
+    fn slots(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..WIDTH).filter(|&s| self.used & (1 << s) != 0)
+    }
+
+    /// The box of the child in `slot`.
+    fn child_box(&self, slot: usize) -> Aabb {
+        Aabb {
+            lo: [0, 1, 2].map(|a| self.planes[a][slot]),
+            hi: [0, 1, 2].map(|a| self.planes[3 + a][slot]),
+        }
+    }
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
     /// On huge pages where there are many (see [`super::pages`]). After
@@ -474,30 +489,19 @@ impl Bvh {
         if self.nodes.is_empty() {
             return cost;
         }
+        let root = self.node_at(0);
+        let mut whole = Aabb::EMPTY;
+        for b in root.slots().map(|s| root.child_box(s)) {
+            whole.grow(&b.lo, &b.hi);
+        }
+        let root_area = whole.half_area();
         // (reference, its box's half area)
-        let mut pending = vec![(0u32, f32::NAN)];
-        let mut root_area = f32::NAN;
+        let mut pending = vec![(0u32, root_area)];
         while let Some((reference, area)) = pending.pop() {
             let node = self.node_at(reference as usize);
-            let used: Vec<usize> = (0..WIDTH).filter(|&s| node.used & (1 << s) != 0).collect();
-            let child_box = |s: usize| Aabb {
-                lo: [0, 1, 2].map(|a| node.planes[a][s]),
-                hi: [0, 1, 2].map(|a| node.planes[3 + a][s]),
-            };
-            let area = if reference == 0 {
-                let mut whole = Aabb::EMPTY;
-                for &s in &used {
-                    let b = child_box(s);
-                    whole.grow(&b.lo, &b.hi);
-                }
-                root_area = whole.half_area();
-                root_area
-            } else {
-                area
-            };
             cost.nodes += (area / root_area) as f64;
-            for s in used {
-                let (child, child_area) = (node.children[s], child_box(s).half_area());
+            for s in node.slots() {
+                let (child, child_area) = (node.children[s], node.child_box(s).half_area());
                 if is_leaf(child) {
                     let blocks = leaf_run(child).1.div_ceil(block.max(1));
                     cost.leaves += (child_area / root_area) as f64 * blocks as f64;
@@ -521,7 +525,7 @@ impl Bvh {
         };
         while let Some(reference) = pending.pop() {
             let node = self.node_at(reference as usize);
-            for slot in (0..WIDTH).filter(|&s| node.used & (1 << s) != 0) {
+            for slot in node.slots() {
                 let child = node.children[slot];
                 if is_leaf(child) {
                     leaves.push(leaf_run(child));
@@ -1203,7 +1207,7 @@ mod tests {
         while let Some(at) = pending.pop() {
             let node: Node = unsafe { std::ptr::read(bytes[at..].as_ptr() as *const Node) };
             let mut next = at + NODE_BYTES as usize;
-            for slot in (0..WIDTH).filter(|&s| node.used & (1 << s) != 0) {
+            for slot in node.slots() {
                 let child = node.children[slot];
                 if !is_leaf(child) {
                     pending.push(child as usize);

@@ -113,18 +113,14 @@ impl Grid {
         // Asked of a cell grown as the item's box is, and by a little of its size more,
         // so that the finer test's own rounding never leaves an item out either.
         let pad = margin + 1e-6 * grid.cell_size.max_component();
-        let kept = |i: u32, box_cells: &Bounds3, cell: [usize; 3]| match reaches {
-            Some(reaches) if !grid.one_cell(box_cells) => {
-                reaches(i, &grid.cell_bounds(cell).expanded(pad))
-            }
-            _ => true,
-        };
-        // Each item's cells, by its box and then by `reaches`; listed once, filed twice.
+        // Each item's cells, by its box and then by `reaches` (an item whose box lies in
+        // one cell reaches into it); listed once, filed twice.
         let cells_of = |i: u32| {
             let b = filed(i);
+            let finer = reaches.filter(|_| !grid.one_cell(&b));
             let mut cells = Vec::new();
             grid.for_cells(&b, |c, cell| {
-                if kept(i, &b, cell) {
+                if finer.is_none_or(|reaches| reaches(i, &grid.cell_bounds(cell).expanded(pad))) {
                     cells.push(c)
                 }
             });
