@@ -415,7 +415,7 @@ mod tests {
             inside: impl Fn(Vec3) -> bool,
         ) -> f64 {
             let s = point.dot(normal) / w.dot(normal);
-            if !(s > 0.0) || !inside(w * s) {
+            if s.is_nan() || s <= 0.0 || !inside(w * s) {
                 return 0.0;
             }
             s * s / (w.dot(normal).abs() * area)

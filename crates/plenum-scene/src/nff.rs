@@ -200,7 +200,7 @@ pub fn parse(path: &Path, text: &str) -> Result<(SceneBuilder, RenderDefaults), 
 fn cone(base: Vec3, r0: f64, apex: Vec3, r1: f64) -> Option<(Shape, Transform)> {
     let axis = apex - base;
     let height = axis.length();
-    if !(height > 0.0) || (r0 == 0.0 && r1 == 0.0) {
+    if height.is_nan() || height <= 0.0 || (r0 == 0.0 && r1 == 0.0) {
         return None;
     }
     let z = axis / height;

@@ -349,7 +349,7 @@ impl<'s> Parser<'s> {
                 "aspectratio" => {
                     let s = self.span();
                     let a = self.field(Self::number)?;
-                    if !(a > 0.0) {
+                    if a.is_nan() || a <= 0.0 {
                         return Err(self.error(s, "expected an aspect ratio > 0"));
                     }
                     self.aspect = a;
@@ -541,7 +541,7 @@ impl<'s> Parser<'s> {
                 "index" => {
                     let s = self.span();
                     let n = self.field(Self::number)?;
-                    if !(n > 0.0) {
+                    if n.is_nan() || n <= 0.0 {
                         return Err(self.error(s, "expected an index of refraction > 0"));
                     }
                     block.material.ior = n;
@@ -801,7 +801,7 @@ impl<'s> Parser<'s> {
             }
             "cylinder" => Shape::Cylinder(Cylinder::new(1.0, 1.0, true)),
             _ => {
-                if !(height > 0.0) || bottom < 0.0 || top < 0.0 || bottom + top == 0.0 {
+                if height.is_nan() || height <= 0.0 || bottom < 0.0 || top < 0.0 || bottom + top == 0.0 {
                     return Err(self.error(
                         span,
                         "expected a cone with height > 0 and radii ≥ 0, not both zero",

@@ -26,9 +26,9 @@ const MACRO: usize = 4;
 #[derive(Clone, Debug)]
 pub struct Grid {
     /// The cells' region: the bounds of the items in them.
-    bounds: Bounds3,
+    region: Bounds3,
     /// The bounds of all the items, large ones included.
-    all_bounds: Bounds3,
+    bounds: Bounds3,
     /// Items as large as the scene, tested by every ray (see [`split_off_large`]).
     large: Vec<u32>,
     /// After [`Grid::take_padded_runs`], the large items' run: the first `large_run` slots.
@@ -60,10 +60,9 @@ impl Grid {
             })
         };
         let bounds = union(&bounded);
-        let all_bounds = bounds.union(&union(&large));
         let mut grid = Grid {
-            bounds,
-            all_bounds,
+            region: bounds,
+            bounds: bounds.union(&union(&large)),
             large,
             large_run: 0,
             resolution: [1; 3],
@@ -164,7 +163,7 @@ impl Grid {
     }
 
     pub fn bounds(&self) -> Bounds3 {
-        self.all_bounds
+        self.bounds
     }
 
     pub fn resolution(&self) -> [usize; 3] {
@@ -180,7 +179,7 @@ impl Grid {
     fn cell_of(&self, x: f64, axis: usize) -> usize {
         // Truncation is floor here (c ≥ 0), without a call into libm; a signed conversion
         // is one instruction, and the clamp keeps it in range.
-        let c = (x - self.bounds.min[axis]) * self.inv_cell_size[axis];
+        let c = (x - self.region.min[axis]) * self.inv_cell_size[axis];
         (c.min(MAX_RESOLUTION as f64) as i64).clamp(0, self.resolution[axis] as i64 - 1) as usize
     }
 
@@ -207,9 +206,9 @@ impl Grid {
     fn cell_bounds(&self, cell: [usize; 3]) -> Bounds3 {
         let corner = |c: [usize; 3]| {
             Vec3::new(
-                self.bounds.min.x + c[0] as f64 * self.cell_size.x,
-                self.bounds.min.y + c[1] as f64 * self.cell_size.y,
-                self.bounds.min.z + c[2] as f64 * self.cell_size.z,
+                self.region.min.x + c[0] as f64 * self.cell_size.x,
+                self.region.min.y + c[1] as f64 * self.cell_size.y,
+                self.region.min.z + c[2] as f64 * self.cell_size.z,
             )
         };
         Bounds3::new(corner(cell), corner(cell.map(|c| c + 1)))
@@ -307,7 +306,7 @@ impl Grid {
             return;
         }
         let walk = Walk::new(self, ray);
-        let Some((t_enter, t_exit)) = self.bounds.intersect(ray, walk.inv_dir, t_max) else {
+        let Some((t_enter, t_exit)) = self.region.intersect(ray, walk.inv_dir, t_max) else {
             return;
         };
         let mut limit = t_max.min(t_exit);
@@ -474,7 +473,7 @@ impl Walk {
     /// When the ray crosses wall `wall` (the low wall of that cell) along axis `a`.
     fn time_at(&self, grid: &Grid, a: usize, wall: usize) -> f64 {
         // Through i64: an unsigned conversion to f64 takes several instructions.
-        let x = grid.bounds.min[a] + wall as i64 as f64 * grid.cell_size[a];
+        let x = grid.region.min[a] + wall as i64 as f64 * grid.cell_size[a];
         (x - self.origin[a]) * self.inv_dir[a]
     }
 

@@ -72,9 +72,9 @@ const EMPTY_BLOCK: Siblings = Siblings(
 #[derive(Clone, Debug)]
 pub struct Octree {
     /// The root cell: the bounds of the items filed in cells.
-    bounds: Bounds3,
+    region: Bounds3,
     /// The bounds of all the items, large ones included.
-    all_bounds: Bounds3,
+    bounds: Bounds3,
     /// Items as large as the scene, tested by every ray (see [`split_off_large`]).
     large: Vec<u32>,
     /// After [`Octree::take_padded_runs`], the large items' run: the first `large_run` slots.
@@ -119,8 +119,8 @@ impl Octree {
         };
         let bounds = union(&bounded);
         let mut tree = Octree {
-            bounds,
-            all_bounds: bounds.union(&union(&large)),
+            region: bounds,
+            bounds: bounds.union(&union(&large)),
             large,
             large_run: 0,
             blocks: vec![EMPTY_BLOCK],
@@ -135,8 +135,8 @@ impl Octree {
         // Items are filed by slightly grown boxes so rounding never drops one from a cell.
         let margin = bounds.diagonal().max_component() * 1e-9;
         let filed: Vec<Bounds3> = item_bounds.iter().map(|b| b.expanded(margin)).collect();
-        tree.bounds = bounds.expanded(margin);
-        let (lo, hi) = (tree.bounds.min, tree.bounds.max);
+        tree.region = bounds.expanded(margin);
+        let (lo, hi) = (tree.region.min, tree.region.max);
         let filing = Filing {
             boxes: &filed,
             margin,
@@ -229,7 +229,7 @@ impl Octree {
     }
 
     pub fn bounds(&self) -> Bounds3 {
-        self.all_bounds
+        self.bounds
     }
 
     pub fn memory_bytes(&self) -> usize {
@@ -319,7 +319,7 @@ impl Octree {
         // runs down, so that it runs up every axis; octant bits in `flip` undo the mirroring.
         // A zero direction component becomes a tiny positive one: its planes are then
         // crossed at ±huge distances, never inside a cell, which is the right answer.
-        let (lo, hi) = (self.bounds.min, self.bounds.max);
+        let (lo, hi) = (self.region.min, self.region.max);
         let mut flip = 0;
         let mut t0 = [0.0; 3];
         let mut t1 = [0.0; 3];

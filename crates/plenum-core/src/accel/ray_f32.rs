@@ -285,6 +285,7 @@ mod tests {
     /// ray), seed 8: no box the ray crosses is missed, no entry distance overestimated by
     /// more than 1e-6 relative, and no box missed by more than 1e-5 relative reported.
     #[test]
+    #[allow(clippy::needless_range_loop)] // a lane indexes an entry and an exit row at once
     fn node_tests_bracket_the_exact_slab_test() {
         let mut rng = Rng::new(8, 0);
         let mut v = || rng.uniform() * 4.0 - 2.0;

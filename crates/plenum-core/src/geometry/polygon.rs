@@ -56,7 +56,7 @@ impl Polygon {
             .diagonal()
             .length();
         // Compared as area/size against size, so huge coordinates do not overflow.
-        if !(size > 0.0) || area_vector.length() / size <= 1e-12 * size {
+        if size.is_nan() || size <= 0.0 || area_vector.length() / size <= 1e-12 * size {
             return Err(PolygonError::ZeroArea);
         }
         let normal = area_vector.normalized();
