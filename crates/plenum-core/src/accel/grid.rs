@@ -10,7 +10,7 @@
 
 use super::mailbox::{new_owner, Mailbox};
 use super::pages::LargeArray;
-use super::{append_padded, nearest, split_off_large, Reaches};
+use super::{append_padded, nearest, split_off_large, LargeSplit, Reaches};
 use crate::math::{Bounds3, Ray, Vec3};
 use std::ops::Range;
 
@@ -53,16 +53,15 @@ impl Grid {
     /// time; with `reaches`, an item is filed only in the cells it may reach into.
     pub fn build(item_bounds: &[Bounds3], block: usize, reaches: Option<Reaches>) -> Grid {
         let lambda = if block > 1 { LAMBDA_BLOCKS } else { LAMBDA };
-        let (bounded, large) = split_off_large(item_bounds);
-        let union = |items: &[u32]| {
-            items.iter().fold(Bounds3::default(), |b, &i| {
-                b.union(&item_bounds[i as usize])
-            })
-        };
-        let bounds = union(&bounded);
+        let LargeSplit {
+            filed: bounded,
+            large,
+            region,
+            bounds,
+        } = split_off_large(item_bounds);
         let mut grid = Grid {
-            region: bounds,
-            bounds: bounds.union(&union(&large)),
+            region,
+            bounds,
             large,
             large_run: 0,
             resolution: [1; 3],
@@ -78,7 +77,7 @@ impl Grid {
         if bounded.is_empty() {
             return grid;
         }
-        let extent = bounds.diagonal();
+        let extent = region.diagonal();
         let longest = extent.max_component();
         // Flat or point-like scenes: give every axis some thickness so the volume is positive.
         let floor = (longest * 1e-3).max(f64::MIN_POSITIVE);

@@ -42,22 +42,43 @@ const MAX_LARGE: usize = 16;
 /// leave the model few of them ("the teapot in a stadium"), and be tested in every cell the
 /// ray crosses anyway. Many large items stay filed: testing them all per ray would be brute
 /// force.
-fn split_off_large(item_bounds: &[Bounds3]) -> (Vec<u32>, Vec<u32>) {
+fn split_off_large(item_bounds: &[Bounds3]) -> LargeSplit {
+    let union = |items: &[u32]| {
+        items.iter().fold(Bounds3::default(), |b, &i| {
+            b.union(&item_bounds[i as usize])
+        })
+    };
     let bounded: Vec<u32> = (0..item_bounds.len() as u32)
         .filter(|&i| !item_bounds[i as usize].is_empty())
         .collect();
-    let scene = bounded.iter().fold(Bounds3::default(), |b, &i| {
-        b.union(&item_bounds[i as usize])
-    });
-    let threshold = LARGE_SHARE * scene.surface_area();
+    let bounds = union(&bounded);
+    let threshold = LARGE_SHARE * bounds.surface_area();
     let (large, filed): (Vec<u32>, Vec<u32>) = bounded
         .iter()
         .partition(|&&i| item_bounds[i as usize].surface_area() > threshold);
-    if large.len() <= MAX_LARGE && !filed.is_empty() {
+    let (filed, large) = if large.len() <= MAX_LARGE && !filed.is_empty() {
         (filed, large)
     } else {
         (bounded, Vec::new())
+    };
+    LargeSplit {
+        region: union(&filed),
+        bounds,
+        filed,
+        large,
     }
+}
+
+/// Items parted by [`split_off_large`].
+struct LargeSplit {
+    /// Those to file in cells.
+    filed: Vec<u32>,
+    /// Those every ray tests.
+    large: Vec<u32>,
+    /// The bounds of the filed items: the region the cells divide.
+    region: Bounds3,
+    /// The bounds of all the items.
+    bounds: Bounds3,
 }
 
 /// Which acceleration structure to build.
@@ -322,15 +343,15 @@ mod tests {
             .collect();
         items.push(ground);
         items.push(Bounds3::default());
-        let (filed, large) = split_off_large(&items);
+        let LargeSplit { filed, large, .. } = split_off_large(&items);
         assert_eq!(large, vec![20]);
         assert_eq!(filed, (0..20).collect::<Vec<u32>>());
         // Nothing but large items: they stay filed.
-        let (filed, large) = split_off_large(&[ground, ground]);
+        let LargeSplit { filed, large, .. } = split_off_large(&[ground, ground]);
         assert_eq!((filed, large), (vec![0, 1], vec![]));
         // More large items than are worth testing on every ray.
         let walls = vec![ground; MAX_LARGE + 1];
-        let (filed, large) = split_off_large(&[walls, vec![cube(Vec3::ZERO, 0.1)]].concat());
+        let LargeSplit { filed, large, .. } = split_off_large(&[walls, vec![cube(Vec3::ZERO, 0.1)]].concat());
         assert_eq!((filed.len(), large.len()), (MAX_LARGE + 2, 0));
     }
 }

@@ -6,7 +6,7 @@
 //! visited front to back. Items filed in several cells are mailboxed.
 
 use super::mailbox::{new_owner, Mailbox};
-use super::{append_padded, nearest, split_off_large, Reaches};
+use super::{append_padded, nearest, split_off_large, LargeSplit, Reaches};
 use crate::math::{Bounds3, Ray, Vec3};
 use std::mem::MaybeUninit;
 use std::ops::Range;
@@ -111,16 +111,15 @@ impl Octree {
     /// at a time; with `reaches`, an item is filed only in the cells it may reach into.
     pub fn build(item_bounds: &[Bounds3], block: usize, reaches: Option<Reaches>) -> Octree {
         let splitting = if block > 1 { IN_BLOCKS } else { ONE_BY_ONE };
-        let (bounded, large) = split_off_large(item_bounds);
-        let union = |items: &[u32]| {
-            items.iter().fold(Bounds3::default(), |b, &i| {
-                b.union(&item_bounds[i as usize])
-            })
-        };
-        let bounds = union(&bounded);
+        let LargeSplit {
+            filed: bounded,
+            large,
+            region,
+            bounds,
+        } = split_off_large(item_bounds);
         let mut tree = Octree {
-            region: bounds,
-            bounds: bounds.union(&union(&large)),
+            region,
+            bounds,
             large,
             large_run: 0,
             blocks: vec![EMPTY_BLOCK],
@@ -133,9 +132,9 @@ impl Octree {
             return tree;
         }
         // Items are filed by slightly grown boxes so rounding never drops one from a cell.
-        let margin = bounds.diagonal().max_component() * 1e-9;
+        let margin = region.diagonal().max_component() * 1e-9;
         let filed: Vec<Bounds3> = item_bounds.iter().map(|b| b.expanded(margin)).collect();
-        tree.region = bounds.expanded(margin);
+        tree.region = region.expanded(margin);
         let (lo, hi) = (tree.region.min, tree.region.max);
         let filing = Filing {
             boxes: &filed,
