@@ -801,7 +801,12 @@ impl<'s> Parser<'s> {
             }
             "cylinder" => Shape::Cylinder(Cylinder::new(1.0, 1.0, true)),
             _ => {
-                if height.is_nan() || height <= 0.0 || bottom < 0.0 || top < 0.0 || bottom + top == 0.0 {
+                if height.is_nan()
+                    || height <= 0.0
+                    || bottom < 0.0
+                    || top < 0.0
+                    || bottom + top == 0.0
+                {
                     return Err(self.error(
                         span,
                         "expected a cone with height > 0 and radii ≥ 0, not both zero",

@@ -351,7 +351,8 @@ mod tests {
         assert_eq!((filed, large), (vec![0, 1], vec![]));
         // More large items than are worth testing on every ray.
         let walls = vec![ground; MAX_LARGE + 1];
-        let LargeSplit { filed, large, .. } = split_off_large(&[walls, vec![cube(Vec3::ZERO, 0.1)]].concat());
+        let LargeSplit { filed, large, .. } =
+            split_off_large(&[walls, vec![cube(Vec3::ZERO, 0.1)]].concat());
         assert_eq!((filed.len(), large.len()), (MAX_LARGE + 2, 0));
     }
 }
