@@ -56,16 +56,20 @@ fn split_off_large(item_bounds: &[Bounds3]) -> LargeSplit {
     let (large, filed): (Vec<u32>, Vec<u32>) = bounded
         .iter()
         .partition(|&&i| item_bounds[i as usize].surface_area() > threshold);
-    let (filed, large) = if large.len() <= MAX_LARGE && !filed.is_empty() {
-        (filed, large)
+    if large.len() <= MAX_LARGE && !filed.is_empty() {
+        LargeSplit {
+            region: union(&filed),
+            bounds,
+            filed,
+            large,
+        }
     } else {
-        (bounded, Vec::new())
-    };
-    LargeSplit {
-        region: union(&filed),
-        bounds,
-        filed,
-        large,
+        LargeSplit {
+            region: bounds,
+            bounds,
+            filed: bounded,
+            large: Vec::new(),
+        }
     }
 }
 
