@@ -5,9 +5,9 @@
 //! the two compared pass by pass and hit by hit.
 
 use clap::Args;
-use plenum_core::accel::{AccelKind, SahCost};
+use plenum_core::accel::{AccelKind, Coherence, SahCost};
 use plenum_core::geometry::TriangleMesh;
-use plenum_core::math::{Ray, Vec3};
+use plenum_core::math::{Bounds3, Ray, Vec3};
 use plenum_core::scene::Scene;
 use plenum_scene::ray_files::{read_rays, write_hits, FileHit, FileRay};
 use rayon::prelude::*;
@@ -41,9 +41,92 @@ pub struct BenchArgs {
     /// runs of a few seconds then slows both alike.
     #[arg(long)]
     baseline: Option<BenchAccel>,
+    /// Whether the rays follow one another (camera rays) or not, a hint to the any-hit
+    /// walk that changes its speed, never its hits: coherent, incoherent, or auto (found
+    /// from the rays: see `RaysCoherence::of`). Embree is given the same hint.
+    #[arg(long, default_value = "auto")]
+    coherence: CoherenceArg,
     /// Print JSON instead of text.
     #[arg(long)]
     json: bool,
+}
+
+/// What `--coherence` names.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum CoherenceArg {
+    Auto,
+    Coherent,
+    Incoherent,
+}
+
+/// Whether a file's rays are coherent, and the share of them that follow the ray before.
+struct RaysCoherence {
+    coherence: Coherence,
+    /// Of consecutive rays, the share within [`NEIGHBOUR_DEGREES`] of each other's direction
+    /// and [`NEIGHBOUR_SPREAD`] of the origins' spread of each other's origin.
+    neighbours: f64,
+    /// Whether `--coherence` said so rather than the rays.
+    forced: bool,
+}
+
+/// Consecutive rays closer than this in direction, in degrees, may be neighbours: some 25
+/// pixels apart in a 1024-pixel image 40° across.
+const NEIGHBOUR_DEGREES: f64 = 1.0;
+/// ... and closer than this share of the diagonal of the box around all origins.
+const NEIGHBOUR_SPREAD: f64 = 0.01;
+
+impl RaysCoherence {
+    /// Found from the rays: coherent where at least half of them are neighbours of the ray
+    /// before (camera rays from one point in scanline order: all but a row's first; rays
+    /// made at random: next to none).
+    fn of(rays: &[FileRay], arg: CoherenceArg) -> RaysCoherence {
+        let origin =
+            |r: &FileRay| Vec3::new(r.origin[0] as f64, r.origin[1] as f64, r.origin[2] as f64);
+        let direction = |r: &FileRay| {
+            Vec3::new(
+                r.direction[0] as f64,
+                r.direction[1] as f64,
+                r.direction[2] as f64,
+            )
+        };
+        let near_origin = match rays.len() {
+            0 | 1 => 0.0,
+            _ => {
+                NEIGHBOUR_SPREAD
+                    * Bounds3::from_points(rays.iter().map(origin))
+                        .diagonal()
+                        .length()
+            }
+        };
+        let near_direction = NEIGHBOUR_DEGREES.to_radians().cos();
+        let neighbours = rays
+            .windows(2)
+            .filter(|pair| {
+                let (a, b) = (&pair[0], &pair[1]);
+                (origin(a) - origin(b)).length() <= near_origin
+                    && direction(a).dot(direction(b)) >= near_direction
+            })
+            .count() as f64
+            / rays.len().saturating_sub(1).max(1) as f64;
+        let (coherence, forced) = match arg {
+            CoherenceArg::Auto if neighbours >= 0.5 => (Coherence::Coherent, false),
+            CoherenceArg::Auto => (Coherence::Incoherent, false),
+            CoherenceArg::Coherent => (Coherence::Coherent, true),
+            CoherenceArg::Incoherent => (Coherence::Incoherent, true),
+        };
+        RaysCoherence {
+            coherence,
+            neighbours,
+            forced,
+        }
+    }
+
+    fn name(&self) -> &'static str {
+        match self.coherence {
+            Coherence::Coherent => "coherent",
+            Coherence::Incoherent => "incoherent",
+        }
+    }
 }
 
 /// What `--accel` names: one of Plenum's structures, or Embree.
@@ -98,12 +181,12 @@ impl Target {
         }
     }
 
-    fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
+    fn occluded(&self, ray: &Ray, t_max: f64, coherence: Coherence) -> bool {
         match self {
-            Target::Mesh(m) => m.intersect_any(ray, t_max).is_some(),
+            Target::Mesh(m) => m.intersect_any_as(ray, t_max, coherence).is_some(),
             Target::Scene(s) => s.occluded(ray, t_max),
             #[cfg(feature = "embree")]
-            Target::Embree(e) => e.occluded(ray, t_max),
+            Target::Embree(e) => e.occluded(ray, t_max, coherence),
         }
     }
 
@@ -192,10 +275,12 @@ pub fn run(args: BenchArgs) -> ExitCode {
     let (target, build_seconds) = build(args.accel);
     let baseline = args.baseline.map(|accel| (accel, build(accel)));
     let rays: Vec<Prepared> = file_rays.iter().map(prepare).collect();
+    let coherence = RaysCoherence::of(&file_rays, args.coherence);
     let threads = pool.current_num_threads();
     let closest_pass =
         |target: &Target, hits: &mut [FileHit]| pool.install(|| trace_closest(target, &rays, hits));
-    let any_pass = |target: &Target| pool.install(|| count_occluded(target, &rays));
+    let any_pass =
+        |target: &Target| pool.install(|| count_occluded(target, &rays, coherence.coherence));
 
     let mut hits = vec![FileHit::MISS; rays.len()];
     let mut occluded = 0;
@@ -258,6 +343,7 @@ pub fn run(args: BenchArgs) -> ExitCode {
         });
     let output = Output {
         report: measured.report(&geometry, threads),
+        coherence,
         against,
     };
 
@@ -317,11 +403,11 @@ fn trace_closest(target: &Target, rays: &[Prepared], hits: &mut [FileHit]) {
 }
 
 /// How many rays are blocked, by any-hit queries across the pool's threads.
-fn count_occluded(target: &Target, rays: &[Prepared]) -> usize {
+fn count_occluded(target: &Target, rays: &[Prepared], coherence: Coherence) -> usize {
     rays.par_chunks(1024)
         .map(|rays| {
             rays.iter()
-                .filter(|r| target.occluded(&r.ray, r.t_max))
+                .filter(|r| target.occluded(&r.ray, r.t_max, coherence))
                 .count()
         })
         .sum()
@@ -494,12 +580,18 @@ struct Against {
 
 struct Output {
     report: Report,
+    coherence: RaysCoherence,
     against: Option<Against>,
 }
 
 impl Output {
     fn json(&self) -> String {
         let mut json = self.report.json();
+        json["coherence"] = serde_json::json!({
+            "hint": self.coherence.name(),
+            "neighbours": self.coherence.neighbours,
+            "forced": self.coherence.forced,
+        });
         if let Some(against) = &self.against {
             json["baseline"] = serde_json::json!({
                 "report": against.baseline.json(),
@@ -513,6 +605,17 @@ impl Output {
 
     fn print(&self, rays: &Path, passes: usize) {
         self.report.print(rays, passes);
+        let c = &self.coherence;
+        println!(
+            "any hit walked for {} rays ({}): {:.1} % follow the ray before",
+            c.name(),
+            if c.forced {
+                "--coherence"
+            } else {
+                "found from the rays"
+            },
+            100.0 * c.neighbours
+        );
         if let Some(against) = &self.against {
             let b = &against.baseline;
             println!();
@@ -634,6 +737,73 @@ impl Report {
             self.any_mrays_per_s,
             self.any_ms,
             self.occluded_fraction * 100.0
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plenum_core::sampling::{uniform_sphere, Rng};
+
+    fn file_ray(origin: Vec3, direction: Vec3) -> FileRay {
+        let d = direction.normalized();
+        FileRay {
+            origin: [origin.x as f32, origin.y as f32, origin.z as f32],
+            t_min: 0.0,
+            direction: [d.x as f32, d.y as f32, d.z as f32],
+            t_max: f32::INFINITY,
+        }
+    }
+
+    /// Camera rays from one point through a 64 × 64 image 40° across, in scanline order,
+    /// follow one another but for each row's first; rays between random points (seed
+    /// 0x5EED0C0E) do not; too few rays to tell are incoherent; `--coherence` overrides.
+    #[test]
+    fn coherence_is_found_from_the_rays() {
+        let eye = Vec3::new(0.0, 0.0, 5.0);
+        let half = 20f64.to_radians().tan();
+        let camera: Vec<FileRay> = (0..64 * 64)
+            .map(|i| {
+                let (x, y) = ((i % 64) as f64, (i / 64) as f64);
+                let u = ((x + 0.5) / 32.0 - 1.0) * half;
+                let v = (1.0 - (y + 0.5) / 32.0) * half;
+                file_ray(eye, Vec3::new(u, v, -1.0))
+            })
+            .collect();
+        let found = RaysCoherence::of(&camera, CoherenceArg::Auto);
+        assert_eq!(found.coherence, Coherence::Coherent);
+        assert!(!found.forced);
+        let rows_first = 63.0 / (64.0 * 64.0 - 1.0);
+        assert!(
+            (found.neighbours - (1.0 - rows_first)).abs() < 1e-9,
+            "{}",
+            found.neighbours
+        );
+
+        let mut rng = Rng::new(0x5EED0C0E, 0);
+        let mut point = || uniform_sphere([rng.uniform(), rng.uniform()]);
+        let random: Vec<FileRay> = (0..4096)
+            .map(|_| {
+                let (a, b) = (point(), point());
+                file_ray(a, b - a)
+            })
+            .collect();
+        let found = RaysCoherence::of(&random, CoherenceArg::Auto);
+        assert_eq!(found.coherence, Coherence::Incoherent);
+        assert!(found.neighbours < 0.01, "{}", found.neighbours);
+
+        for few in [&camera[..0], &camera[..1]] {
+            let found = RaysCoherence::of(few, CoherenceArg::Auto);
+            assert_eq!(
+                (found.coherence, found.neighbours),
+                (Coherence::Incoherent, 0.0)
+            );
+        }
+        let forced = RaysCoherence::of(&random, CoherenceArg::Coherent);
+        assert_eq!(
+            (forced.coherence, forced.forced),
+            (Coherence::Coherent, true)
         );
     }
 }

@@ -4,6 +4,7 @@
 //! with its high-quality builder and traces with rtcIntersect1 / rtcOccluded1, one ray at a
 //! time, from the same threads as Plenum's structures, so the two are measured alike.
 
+use plenum_core::accel::Coherence;
 use plenum_core::geometry::TriangleMesh;
 use plenum_core::math::Ray;
 use std::ffi::{c_char, c_void, CString};
@@ -178,9 +179,14 @@ impl EmbreeMesh {
         }
     }
 
-    fn context() -> IntersectContext {
+    /// A context hinting at `coherence` (RTC_INTERSECT_CONTEXT_FLAG_COHERENT or its
+    /// absence, INCOHERENT), as Plenum's any-hit walk is given.
+    fn context(coherence: Coherence) -> IntersectContext {
         IntersectContext {
-            flags: 0,
+            flags: match coherence {
+                Coherence::Coherent => 1,
+                Coherence::Incoherent => 0,
+            },
             filter: std::ptr::null(),
             inst_id: [INVALID_GEOMETRY_ID],
         }
@@ -199,16 +205,16 @@ impl EmbreeMesh {
                 inst_id: [INVALID_GEOMETRY_ID],
             },
         };
-        let mut context = EmbreeMesh::context();
+        let mut context = EmbreeMesh::context(Coherence::Incoherent);
         // SAFETY: a committed scene, and a ray-hit laid out and aligned as Embree's.
         unsafe { rtcIntersect1(self.scene, &mut context, &mut rh) };
         (rh.hit.geom_id != INVALID_GEOMETRY_ID).then_some((rh.ray.tfar as f64, rh.hit.prim_id))
     }
 
-    /// Whether anything is hit in (0, t_max).
-    pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
+    /// Whether anything is hit in (0, t_max), for one of `coherence` rays.
+    pub fn occluded(&self, ray: &Ray, t_max: f64, coherence: Coherence) -> bool {
         let mut r = EmbreeMesh::ray(ray, t_max);
-        let mut context = EmbreeMesh::context();
+        let mut context = EmbreeMesh::context(coherence);
         // SAFETY: as for `closest`; Embree sets tfar to −∞ on a hit.
         unsafe { rtcOccluded1(self.scene, &mut context, &mut r) };
         r.tfar == f32::NEG_INFINITY
@@ -261,7 +267,7 @@ mod tests {
             };
             disagree += usize::from(!same);
             assert_eq!(
-                embree.occluded(&ray, 1.0),
+                embree.occluded(&ray, 1.0, Coherence::Incoherent),
                 theirs.is_some(),
                 "Embree's any-hit and closest-hit differ"
             );

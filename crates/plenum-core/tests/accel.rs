@@ -5,7 +5,7 @@
 //! degenerate and tiny triangles, spheres and polygons, axis-parallel rays, rays that start
 //! on a surface, and the empty scene.
 
-use plenum_core::accel::AccelKind;
+use plenum_core::accel::{AccelKind, Coherence};
 use plenum_core::geometry::{Polygon, Shape, Sphere, TriangleMesh};
 use plenum_core::material::Material;
 use plenum_core::math::{Ray, Transform, Vec3};
@@ -100,15 +100,24 @@ fn check_mesh(triangles: &[[Vec3; 3]], rays: &[Ray]) -> Result<(), TestCaseError
                 .intersect(ray, f64::INFINITY)
                 .map(|h| (m.source_triangle(h.part), h.t));
             agree(got, want).map_err(|e| TestCaseError::fail(format!("{kind}: {ray:?}: {e}")))?;
-            let any = m.intersect_any(ray, f64::INFINITY).is_some();
-            prop_assert_eq!(any, got.is_some(), "{}: any-hit disagrees", kind);
-            // A shorter segment: any-hit and closest-hit agree there too.
-            if let Some((_, t)) = want {
-                let short = t * 0.5;
+            // Any hit, walked either way the coherence hint chooses.
+            for coherence in [Coherence::Incoherent, Coherence::Coherent] {
+                let any = m.intersect_any_as(ray, f64::INFINITY, coherence).is_some();
                 prop_assert_eq!(
-                    m.intersect_any(ray, short).is_some(),
-                    m.intersect(ray, short).is_some()
+                    any,
+                    got.is_some(),
+                    "{}: any-hit disagrees ({:?})",
+                    kind,
+                    coherence
                 );
+                // A shorter segment: any-hit and closest-hit agree there too.
+                if let Some((_, t)) = want {
+                    let short = t * 0.5;
+                    prop_assert_eq!(
+                        m.intersect_any_as(ray, short, coherence).is_some(),
+                        m.intersect(ray, short).is_some()
+                    );
+                }
             }
         }
     }

@@ -18,7 +18,9 @@ pub(crate) mod ray_f32;
 pub(crate) mod simd;
 
 pub use brute::BruteForce;
-pub use bvh::{AmongNodes, Bvh, LeafItems, LeafPlaces, SahCost, EMBED_LIMIT, EMBED_UNIT};
+pub use bvh::{
+    AmongNodes, Bvh, Coherence, LeafItems, LeafPlaces, SahCost, EMBED_LIMIT, EMBED_UNIT,
+};
 pub use grid::Grid;
 pub use octree::Octree;
 

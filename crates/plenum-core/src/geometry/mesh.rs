@@ -17,8 +17,8 @@ use crate::accel::ray_f32::{gamma_f32, round_up_distance};
 use crate::accel::simd::F8;
 use crate::accel::simd::{Avx, Lanes, F4};
 use crate::accel::{
-    bytes_of, Accel, AccelKind, AmongNodes, LeafItems, LeafPlaces, LeafSize, SahCost, EMBED_LIMIT,
-    EMBED_UNIT, PAD,
+    bytes_of, Accel, AccelKind, AmongNodes, Coherence, LeafItems, LeafPlaces, LeafSize, SahCost,
+    EMBED_LIMIT, EMBED_UNIT, PAD,
 };
 use crate::math::{gamma, Bounds3, Ray, Vec3};
 use std::ops::Range;
@@ -454,23 +454,35 @@ impl TriangleMesh {
 
     /// The nearest hit in (0, t_max).
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
-        self.search::<true>(ray, t_max, Avx::detect())
+        self.search::<true>(ray, t_max, Avx::detect(), Coherence::Incoherent)
     }
 
     /// Some hit in (0, t_max), not necessarily the nearest: stops at the first one found.
     pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
-        self.search::<false>(ray, t_max, Avx::detect())
+        self.intersect_any_as(ray, t_max, Coherence::Incoherent)
+    }
+
+    /// [`TriangleMesh::intersect_any`] for a ray that is one of `coherence` rays, which
+    /// chooses how a BVH is walked (see [`Coherence`]); the answer is the same.
+    pub fn intersect_any_as(
+        &self,
+        ray: &Ray,
+        t_max: f64,
+        coherence: Coherence,
+    ) -> Option<HitRecord> {
+        self.search::<false>(ray, t_max, Avx::detect(), coherence)
     }
 
     /// The nearest hit if `NEAREST`, else the first found: the structure hands over runs
     /// of slots (roughly nearest first if `NEAREST`), and their blocks are tested, two at a
-    /// time with `avx`.
+    /// time with `avx`. `coherence` matters to a BVH's any-hit walk only.
     #[inline(always)]
     fn search<const NEAREST: bool>(
         &self,
         ray: &Ray,
         t_max: f64,
         avx: Option<Avx>,
+        coherence: Coherence,
     ) -> Option<HitRecord> {
         let start = |blocks: &[u8]| Search {
             ray,
@@ -498,14 +510,14 @@ impl TriangleMesh {
                         // SAFETY: `avx` says the CPU has AVX.
                         unsafe { self.search_leaf_avx::<NEAREST>(avx, block, count, t_max, state) }
                     };
-                    traverse_bvh::<NEAREST>(bvh, ray, t_max, AmongNodes, visit_run);
+                    traverse_bvh::<NEAREST>(bvh, ray, t_max, AmongNodes, coherence, visit_run);
                     return search.hit;
                 }
                 let visit_run = |run: Range<usize>, t_max: &mut f64| {
                     let (block, count) = (first(&search, &run), run.end - run.start);
                     self.search_run_sse::<NEAREST, true>(block, 0..count, t_max, &mut search)
                 };
-                traverse_bvh::<NEAREST>(bvh, ray, t_max, AmongNodes, visit_run);
+                traverse_bvh::<NEAREST>(bvh, ray, t_max, AmongNodes, coherence, visit_run);
                 search.hit
             }
             _ => {
@@ -531,7 +543,7 @@ impl TriangleMesh {
         match &self.accel {
             Accel::Bvh(bvh) => {
                 let items = LeafItems::<{ std::mem::size_of::<Block>() / LANES }>::at(&self.blocks);
-                traverse_bvh::<NEAREST>(bvh, ray, t_max, items, visit_run);
+                traverse_bvh::<NEAREST>(bvh, ray, t_max, items, Coherence::Incoherent, visit_run);
             }
             Accel::Grid(grid) => grid.traverse_runs(ray, t_max, visit_run),
             Accel::Octree(octree) => octree.traverse_runs(ray, t_max, visit_run),
@@ -979,19 +991,21 @@ fn beyond_error_bound<V: Lanes>(isa: V::Isa, extent: [V; 3], e: [V; 3], det: V, 
     delta_t.lt(t)
 }
 
-/// The BVH's runs for `visit`: nearest first if `NEAREST`, else in any order.
+/// The BVH's runs for `visit`: nearest first if `NEAREST`, else in any order, walked as
+/// suits `coherence` rays.
 #[inline(always)]
 fn traverse_bvh<const NEAREST: bool>(
     bvh: &crate::accel::Bvh,
     ray: &Ray,
     t_max: f64,
     items: impl LeafPlaces,
+    coherence: Coherence,
     visit: impl FnMut(Range<usize>, &mut f64) -> bool,
 ) {
     if NEAREST {
         bvh.traverse_runs(ray, t_max, items, visit);
     } else {
-        bvh.traverse_runs_any_order(ray, t_max, items, visit);
+        bvh.traverse_runs_any_order(ray, t_max, items, coherence, visit);
     }
 }
 
@@ -1394,12 +1408,17 @@ mod tests {
             let mesh = mesh.with_accel(kind);
             let mut hits = 0;
             for ray in &rays {
-                let alone = mesh.search::<true>(ray, f64::INFINITY, None);
-                let paired = mesh.search::<true>(ray, f64::INFINITY, Avx::detect());
+                let incoherent = Coherence::Incoherent;
+                let alone = mesh.search::<true>(ray, f64::INFINITY, None, incoherent);
+                let paired = mesh.search::<true>(ray, f64::INFINITY, Avx::detect(), incoherent);
                 assert_eq!(paired, alone, "{kind}: {ray:?}");
-                let any_alone = mesh.search::<false>(ray, f64::INFINITY, None);
-                let any_paired = mesh.search::<false>(ray, f64::INFINITY, Avx::detect());
-                assert_eq!(any_paired.is_some(), any_alone.is_some(), "{kind}: {ray:?}");
+                for coherence in [Coherence::Incoherent, Coherence::Coherent] {
+                    let any_alone = mesh.search::<false>(ray, f64::INFINITY, None, coherence);
+                    let any_paired =
+                        mesh.search::<false>(ray, f64::INFINITY, Avx::detect(), coherence);
+                    assert_eq!(any_paired.is_some(), alone.is_some(), "{kind}: {ray:?}");
+                    assert_eq!(any_alone.is_some(), alone.is_some(), "{kind}: {ray:?}");
+                }
                 hits += alone.is_some() as usize;
             }
             assert!(hits > 2000, "{kind}: {hits} hits");
