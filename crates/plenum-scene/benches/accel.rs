@@ -4,7 +4,7 @@
 //! after a warm-up, on all cores; each line also gives the ratio to the BVH measured in the
 //! same run. `plenum bench` measures on the shared rays files instead.
 
-use plenum_core::accel::AccelKind;
+use plenum_core::accel::{AccelKind, Coherence};
 use plenum_core::geometry::TriangleMesh;
 use plenum_core::math::{Ray, Vec3};
 use plenum_core::sampling::Rng;
@@ -84,19 +84,17 @@ fn main() {
             std::hint::black_box(mesh.with_accel(kind));
         });
         let m = mesh.with_accel(kind);
-        let trace = |rays: &[Ray], any: bool| {
+        // `any`: any-hit queries for rays of that coherence, else closest-hit ones.
+        let trace = |rays: &[Ray], any: Option<Coherence>| {
             let n = rays.len() as f64;
             n / median(|| {
                 let hits: usize = rays
                     .par_chunks(1024)
                     .map(|c| {
                         c.iter()
-                            .filter(|r| {
-                                if any {
-                                    m.intersect_any(r, f64::INFINITY).is_some()
-                                } else {
-                                    m.intersect(r, f64::INFINITY).is_some()
-                                }
+                            .filter(|r| match any {
+                                Some(c) => m.intersect_any_as(r, f64::INFINITY, c).is_some(),
+                                None => m.intersect(r, f64::INFINITY).is_some(),
                             })
                             .count()
                     })
@@ -105,9 +103,9 @@ fn main() {
             }) / 1e6
         };
         let figures = [
-            trace(&camera, false),
-            trace(&camera, true),
-            trace(&incoherent, false),
+            trace(&camera, None),
+            trace(&camera, Some(Coherence::Coherent)),
+            trace(&incoherent, None),
         ];
         let base = *baseline.get_or_insert(figures);
         println!(
