@@ -184,7 +184,7 @@ impl Target {
     fn occluded(&self, ray: &Ray, t_max: f64, coherence: Coherence) -> bool {
         match self {
             Target::Mesh(m) => m.intersect_any_as(ray, t_max, coherence).is_some(),
-            Target::Scene(s) => s.occluded(ray, t_max),
+            Target::Scene(s) => s.occluded(ray, t_max, coherence),
             #[cfg(feature = "embree")]
             Target::Embree(e) => e.occluded(ray, t_max, coherence),
         }

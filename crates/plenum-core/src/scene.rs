@@ -1,7 +1,7 @@
 //! A scene ready to render: primitives in a BVH, materials, lights, camera and background.
 //! Built once by [`SceneBuilder`]; immutable and shared by every render thread.
 
-use crate::accel::{Accel, AccelKind, LeafSize};
+use crate::accel::{Accel, AccelKind, Coherence, LeafSize};
 use crate::camera::CameraSettings;
 use crate::color::Color;
 use crate::geometry::{Disk, HitRecord, Polygon, Shape, Sphere, TriangleMesh};
@@ -129,12 +129,12 @@ impl Primitive {
     }
 
     /// Some hit in (0, t_max), not necessarily the nearest (see [`Shape::intersect_any`]).
-    pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
+    pub fn intersect_any(&self, ray: &Ray, t_max: f64, coherence: Coherence) -> Option<HitRecord> {
         self.placed(ray.time, |placement| match placement {
-            None => self.shape.intersect_any(ray, t_max),
+            None => self.shape.intersect_any(ray, t_max, coherence),
             Some(t) => {
                 let (local, dt) = t.ray_to_object(ray);
-                let mut hit = self.shape.intersect_any(&local, t_max - dt)?;
+                let mut hit = self.shape.intersect_any(&local, t_max - dt, coherence)?;
                 hit.t += dt;
                 Some(hit)
             }
@@ -210,6 +210,7 @@ impl Scene {
         &self,
         ray: &Ray,
         t_max: f64,
+        coherence: Coherence,
         mut visit: impl FnMut(u32, &HitRecord) -> bool,
     ) {
         let hit_of = |prim: u32| {
@@ -217,7 +218,7 @@ impl Scene {
             if self.transmissive[prim as usize] {
                 p.intersect(ray, t_max)
             } else {
-                p.intersect_any(ray, t_max)
+                p.intersect_any(ray, t_max, coherence)
             }
         };
         let mut go_on = true;
@@ -243,10 +244,10 @@ impl Scene {
         }
     }
 
-    /// Whether anything is hit in (0, t_max).
-    pub fn occluded(&self, ray: &Ray, t_max: f64) -> bool {
+    /// Whether anything is hit in (0, t_max), for one of `coherence` rays.
+    pub fn occluded(&self, ray: &Ray, t_max: f64, coherence: Coherence) -> bool {
         let mut hit = false;
-        self.for_each_hit(ray, t_max, |_, _| {
+        self.for_each_hit(ray, t_max, coherence, |_, _| {
             hit = true;
             false
         });

@@ -241,7 +241,9 @@ fn check_scene(
             let want = oracle.intersect(ray, f64::INFINITY).map(|(p, h)| (p, h.t));
             let got = scene.intersect(ray, f64::INFINITY).map(|(p, h)| (p, h.t));
             agree(got, want).map_err(|e| TestCaseError::fail(format!("{kind}: {e}")))?;
-            prop_assert_eq!(scene.occluded(ray, f64::INFINITY), got.is_some());
+            for coherence in [Coherence::Incoherent, Coherence::Coherent] {
+                prop_assert_eq!(scene.occluded(ray, f64::INFINITY, coherence), got.is_some());
+            }
         }
     }
     Ok(())
@@ -285,7 +287,10 @@ fn empty_scene_misses() {
         let scene = scene_of(&[], &[], kind);
         let ray = Ray::new(Vec3::ZERO, Vec3::new(0.3, -0.2, 1.0));
         assert!(scene.intersect(&ray, f64::INFINITY).is_none(), "{kind}");
-        assert!(!scene.occluded(&ray, f64::INFINITY), "{kind}");
+        assert!(
+            !scene.occluded(&ray, f64::INFINITY, Coherence::Incoherent),
+            "{kind}"
+        );
     }
 }
 

@@ -30,6 +30,7 @@ pub use polygon::{Polygon, PolygonError};
 pub use polyhedron::{Polyhedron, PolyhedronError};
 pub use sphere::Sphere;
 
+use crate::accel::Coherence;
 use crate::math::{Bounds3, Ray, Vec3};
 use std::sync::Arc;
 
@@ -102,10 +103,11 @@ impl Shape {
     }
 
     /// Some hit in (0, t_max), not necessarily the nearest: enough for a shadow ray that
-    /// only asks whether the shape is in the way. Meshes stop at their first hit.
-    pub fn intersect_any(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
+    /// only asks whether the shape is in the way. Meshes stop at their first hit, walking
+    /// their BVH as suits `coherence` rays.
+    pub fn intersect_any(&self, ray: &Ray, t_max: f64, coherence: Coherence) -> Option<HitRecord> {
         match self {
-            Shape::Mesh(s) => s.intersect_any(ray, t_max),
+            Shape::Mesh(s) => s.intersect_any_as(ray, t_max, coherence),
             _ => self.intersect(ray, t_max),
         }
     }
