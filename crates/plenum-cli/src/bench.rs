@@ -80,15 +80,8 @@ impl RaysCoherence {
     /// before (camera rays from one point in scanline order: all but a row's first; rays
     /// made at random: next to none).
     fn of(rays: &[FileRay], arg: CoherenceArg) -> RaysCoherence {
-        let origin =
-            |r: &FileRay| Vec3::new(r.origin[0] as f64, r.origin[1] as f64, r.origin[2] as f64);
-        let direction = |r: &FileRay| {
-            Vec3::new(
-                r.direction[0] as f64,
-                r.direction[1] as f64,
-                r.direction[2] as f64,
-            )
-        };
+        let origin = |r: &FileRay| Vec3::from_array(r.origin.map(f64::from));
+        let direction = |r: &FileRay| Vec3::from_array(r.direction.map(f64::from));
         let near_origin = match rays.len() {
             0 | 1 => 0.0,
             _ => {

@@ -205,7 +205,7 @@ impl Scene {
     /// Calls `visit(primitive, hit)` once for each primitive hit in (0, t_max), in no
     /// particular order, until `visit` returns false: the query of shadow rays. A
     /// transmissive primitive reports its nearest hit (where its material is looked up);
-    /// an opaque one, the first hit found.
+    /// an opaque one, the first hit found, a mesh walked as suits `coherence` rays.
     pub fn for_each_hit(
         &self,
         ray: &Ray,
