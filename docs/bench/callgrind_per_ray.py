@@ -9,7 +9,7 @@
 
 With `--passes 1` the bench traces every ray twice (a warm-up and one pass) for each of the
 closest and any hit, so N is twice the number of rays in the file. The totals are inclusive
-(a function and all it calls) for TriangleMesh::intersect and intersect_any, which is what
+(a function and all it calls) for TriangleMesh::intersect and intersect_any_as, which is what
 one closest-hit and one any-hit ray cost; then the functions' own counts, largest first.
 `--asm` prints the disassembly of one function (its full name, as listed) with how many
 times each instruction ran, for reading where the count goes: a block test's gather, the
@@ -118,7 +118,7 @@ def main():
     args = parser.parse_args()
     own, callees, by_address = parse(args.profile)
     for name in sorted(own):
-        if re.search(r"TriangleMesh::intersect(_any)?$", name):
+        if re.search(r"TriangleMesh::intersect(_any(_as)?)?$", name):
             total = (own[name] + callees[name]) / args.rays
             print(f"{name.rsplit('::', 1)[1]:>14}: {total:8.1f} instructions per ray")
     print("own instructions per ray:")

@@ -1,6 +1,6 @@
-//! An eight-wide bounding-volume hierarchy: a binned surface-area-heuristic build (Wald 2007)
-//! over all three axes, parallel across subtrees, whose binary splits are collapsed so each
-//! node holds eight children; compact f32 nodes tested eight boxes at a time with AVX where
+//! An eight-wide bounding-volume hierarchy: a binary binned surface-area-heuristic build
+//! (Wald 2007) over all three axes, parallel across subtrees, collapsed into nodes of up to
+//! eight children at the least SAH cost (Ylitie, Karras and Laine 2017); compact f32 nodes tested eight boxes at a time with AVX where
 //! the CPU has it (detected at run time) and as two four-box SSE tests otherwise; ordered
 //! front-to-back traversal with a fixed-size stack (no allocation per ray).
 //!
@@ -20,7 +20,7 @@ use super::pages::LargeArray;
 use super::ray_f32::BoxRayAvx;
 use super::ray_f32::{round_down, round_up, round_up_distance, BoxRay};
 use super::simd::F4;
-use super::{append_padded, bytes_of};
+use super::{append_padded, bytes_of, LeafSize};
 use crate::math::{Bounds3, Ray};
 use std::mem::MaybeUninit;
 use std::ops::Range;
@@ -32,11 +32,7 @@ const WIDTH: usize = 8;
 const MAX_DEPTH: usize = 64;
 /// A node pushes at most seven children. Nodes sit at most MAX_DEPTH / 2 levels deep where
 /// splits are binned, and then at most 31 levels more, as every level halves the items.
-const STACK: usize = 7 * (MAX_DEPTH / 2 + 32);
-/// Cost of visiting a node relative to testing one leaf block. With triangles read in place,
-/// a leaf's test costs less than it did through indices, and fuller leaves save calls into
-/// the mesh's leaf loop: 1.0 runs 2–14 % faster than 0.5 (docs/acceleration.md).
-const TRAVERSAL_COST: f32 = 1.0;
+const STACK: usize = 7 * (MAX_DEPTH + 32);
 /// Subtrees with more items than this are built in parallel.
 const PARALLEL_ITEMS: usize = 4096;
 
@@ -186,95 +182,17 @@ impl BuildNode {
             BuildNode::Leaf { bounds, .. } | BuildNode::Inner { bounds, .. } => bounds,
         }
     }
-
-    /// Slots a node's children take when it is merged or opened.
-    fn width(&self) -> usize {
-        match self {
-            BuildNode::Leaf { .. } => 1,
-            BuildNode::Inner { children, .. } => children.len(),
-        }
-    }
-
-    /// Fills the subtree's nodes, bottom up. The top-down build leaves the nodes above the
-    /// leaves part-empty (a run of 12 triangles makes a node of three leaves under a full
-    /// parent: 4.5 children per node on the bunny). Two sibling nodes whose children fit in
-    /// one are merged where their union's surface area is below the sum of theirs (a ray
-    /// then visits fewer nodes on average), and a child node whose children fit in the
-    /// slots so freed is opened into them (a ray that reaches it skips one node).
-    fn fill(&mut self) {
-        let BuildNode::Inner { children, .. } = self else {
-            return;
-        };
-        for child in children.iter_mut() {
-            child.fill();
-        }
-        loop {
-            let inner = |k: usize| matches!(children[k], BuildNode::Inner { .. });
-            // Open the largest child that fits: every ray through its box saves a visit.
-            let free = WIDTH - children.len();
-            if let Some(k) = (0..children.len())
-                .filter(|&k| inner(k) && children[k].width() <= free + 1)
-                .max_by(|&a, &b| {
-                    let area = |k: usize| children[k].bounds().half_area();
-                    area(a).total_cmp(&area(b))
-                })
-            {
-                let BuildNode::Inner {
-                    children: grand, ..
-                } = children.swap_remove(k)
-                else {
-                    unreachable!("chosen among inner nodes");
-                };
-                children.extend(grand);
-                continue;
-            }
-            // Else merge the pair of child nodes that saves the most area.
-            let mut best: Option<(f32, usize, usize)> = None;
-            for a in 0..children.len() {
-                for b in a + 1..children.len() {
-                    if !inner(a) || !inner(b) || children[a].width() + children[b].width() > WIDTH {
-                        continue;
-                    }
-                    let mut union = *children[a].bounds();
-                    union.grow(&children[b].bounds().lo, &children[b].bounds().hi);
-                    let saving = children[a].bounds().half_area()
-                        + children[b].bounds().half_area()
-                        - union.half_area();
-                    if saving > 0.0 && best.is_none_or(|(s, _, _)| saving > s) {
-                        best = Some((saving, a, b));
-                    }
-                }
-            }
-            let Some((_, a, b)) = best else {
-                return;
-            };
-            // b > a: remove b first so a keeps its place.
-            let (
-                BuildNode::Inner {
-                    children: second,
-                    bounds: second_bounds,
-                },
-                BuildNode::Inner {
-                    children: first,
-                    bounds,
-                },
-            ) = (children.swap_remove(b), &mut children[a])
-            else {
-                unreachable!("chosen among inner nodes");
-            };
-            bounds.grow(&second_bounds.lo, &second_bounds.hi);
-            first.extend(second);
-        }
-    }
 }
 
 impl Bvh {
-    /// Builds over items given by their bounds, with at most `max_leaf` items per leaf, for a
-    /// caller that tests `block` items at a time; the leaves refer to items by position.
-    /// Empty boxes are left out.
-    pub fn build(item_bounds: &[Bounds3], max_leaf: usize, block: usize) -> Bvh {
-        let max_leaf = max_leaf.clamp(1, MAX_LEAF_ITEMS);
-        let block = block.clamp(1, max_leaf);
+    /// Builds over items given by their bounds, for a caller that tests leaves as `leaf`
+    /// says; the leaves refer to items by position. Empty boxes are left out.
+    pub fn build(item_bounds: &[Bounds3], leaf: LeafSize) -> Bvh {
+        let leaf = LeafSize {
+            max_leaf: leaf.max_leaf.clamp(1, MAX_LEAF_ITEMS),
+            block: leaf.block.clamp(1, leaf.max_leaf.clamp(1, MAX_LEAF_ITEMS)),
+            ..leaf
+        };
         let mut items: Vec<Item> = item_bounds
             .iter()
             .enumerate()
@@ -294,9 +212,7 @@ impl Bvh {
                 ..Bvh::default()
             };
         }
-        let builder = Builder { max_leaf, block };
-        let mut root = builder.build(&mut items, 0, 0);
-        root.fill();
+        let root = Builder { leaf }.build(&mut items, 0, 0).into_wide();
         let mut nodes = Vec::with_capacity(items.len() / 2 + 1);
         match root {
             leaf @ BuildNode::Leaf { .. } => {
@@ -936,82 +852,44 @@ fn flatten_children(nodes: &mut Vec<Node>, children: &[BuildNode]) -> u32 {
 }
 
 struct Builder {
-    max_leaf: usize,
-    /// Items the caller tests at once: a leaf of `block` items costs one test.
-    block: usize,
+    leaf: LeafSize,
 }
 
 impl Builder {
-    /// Builds the subtree over `items`, which start at `offset` in the final item order.
-    fn build(&self, items: &mut [Item], offset: usize, depth: usize) -> BuildNode {
+    /// Builds the binary tree over `items`, which start at `offset` in the final item
+    /// order, split down to single items and planned for the collapse (see [`Binary`]).
+    fn build(&self, items: &mut [Item], offset: usize, depth: usize) -> Binary {
         let bounds = Aabb::of(items);
-        let Some(mid) = self.split(items, &bounds, depth) else {
-            return BuildNode::Leaf {
-                bounds,
-                start: offset as u32,
-                count: items.len() as u32,
+        let n = items.len();
+        let children = self.split(items, depth).map(|mid| {
+            let (first, second) = items.split_at_mut(mid);
+            let (first, second) = if n > PARALLEL_ITEMS {
+                rayon::join(
+                    || self.build(first, offset, depth + 1),
+                    || self.build(second, offset + mid, depth + 1),
+                )
+            } else {
+                (
+                    self.build(first, offset, depth + 1),
+                    self.build(second, offset + mid, depth + 1),
+                )
             };
-        };
-        // Split the larger parts again until there are eight children (or nothing splits).
-        let mut parts: Vec<(usize, usize, Aabb, bool)> = vec![
-            (0, mid, Aabb::of(&items[..mid]), true),
-            (mid, items.len(), Aabb::of(&items[mid..]), true),
-        ];
-        while parts.len() < WIDTH {
-            let Some(k) = (0..parts.len())
-                .filter(|&k| parts[k].3 && parts[k].1 - parts[k].0 > 1)
-                .max_by(|&a, &b| parts[a].2.half_area().total_cmp(&parts[b].2.half_area()))
-            else {
-                break;
-            };
-            let (s, e, b, _) = parts[k];
-            match self.split(&mut items[s..e], &b, depth + 1) {
-                Some(m) => {
-                    parts[k] = (s, s + m, Aabb::of(&items[s..s + m]), true);
-                    parts.push((s + m, e, Aabb::of(&items[s + m..e]), true));
-                }
-                None => parts[k].3 = false,
-            }
-        }
-        parts.sort_by_key(|p| p.0);
-        // Hand each part its own slice of the items.
-        let mut slices = Vec::with_capacity(parts.len());
-        let mut rest = &mut items[..];
-        let mut consumed = 0;
-        for &(s, e, _, _) in &parts {
-            let (head, tail) = std::mem::take(&mut rest).split_at_mut(e - consumed);
-            debug_assert_eq!(s, consumed);
-            slices.push((head, offset + s));
-            rest = tail;
-            consumed = e;
-        }
-        let children: Vec<BuildNode> = if items_len(&slices) > PARALLEL_ITEMS {
-            use rayon::prelude::*;
-            slices
-                .into_par_iter()
-                .map(|(slice, off)| self.build(slice, off, depth + 2))
-                .collect()
-        } else {
-            slices
-                .into_iter()
-                .map(|(slice, off)| self.build(slice, off, depth + 2))
-                .collect()
-        };
-        BuildNode::Inner { bounds, children }
+            Box::new([first, second])
+        });
+        Binary::planned(bounds, offset, n, children, &self.leaf)
     }
 
-    /// Partitions `items` by the cheapest binned SAH split over the three axes and returns the
-    /// size of the first part; `None` makes a leaf.
-    fn split(&self, items: &mut [Item], bounds: &Aabb, depth: usize) -> Option<usize> {
+    /// Partitions `items` (more than one) by the cheapest binned SAH split over the three
+    /// axes and returns the size of the first part; `None` for a single item.
+    fn split(&self, items: &mut [Item], depth: usize) -> Option<usize> {
         let n = items.len();
-        let must_split = n > self.max_leaf;
         if n <= 1 {
             return None;
         }
         if depth + 2 >= MAX_DEPTH {
             // Halve the run: every level below then at least halves, which bounds the depth
             // (and the traversal stack) whatever the boxes.
-            return must_split.then_some(n / 2);
+            return Some(n / 2);
         }
         let mut centers = Aabb::EMPTY;
         for it in items.iter() {
@@ -1049,39 +927,136 @@ impl Builder {
                 }
             }
         }
-        let leaf_cost = self.leaf_blocks(n);
-        match best {
-            Some((cost, axis, last)) => {
-                let area = bounds.half_area();
-                let split_cost = if area > 0.0 {
-                    TRAVERSAL_COST + cost / area
-                } else {
-                    f32::INFINITY
-                };
-                if !must_split && split_cost >= leaf_cost {
-                    return None;
-                }
-                let (lo, hi) = (centers.lo[axis], centers.hi[axis]);
-                let scale = BINS as f32 / (hi - lo);
-                let mid = partition(items, |it| {
-                    ((((it.center2(axis) - lo) * scale) as usize).min(BINS - 1)) <= last
-                });
-                Some(mid)
-            }
-            // Every centroid coincides: halve the run to keep leaves small.
-            None if must_split => Some(n / 2),
-            None => None,
-        }
+        let Some((_, axis, last)) = best else {
+            // Every centroid coincides: halve the run.
+            return Some(n / 2);
+        };
+        let (lo, hi) = (centers.lo[axis], centers.hi[axis]);
+        let scale = BINS as f32 / (hi - lo);
+        Some(partition(items, |it| {
+            ((((it.center2(axis) - lo) * scale) as usize).min(BINS - 1)) <= last
+        }))
     }
 
-    /// Cost of testing `n` items in leaves.
+    /// Blocks that `n` items fill.
     fn leaf_blocks(&self, n: usize) -> f32 {
-        n.div_ceil(self.block) as f32
+        n.div_ceil(self.leaf.block) as f32
     }
 }
 
-fn items_len(slices: &[(&mut [Item], usize)]) -> usize {
-    slices.iter().map(|(s, _)| s.len()).sum()
+/// A node of the binary tree, planned for its collapse into eight-wide nodes by the
+/// optimal collapse of Ylitie, Karras and Laine (2017): bottom up, each node keeps the
+/// least SAH cost of its subtree spread over at most j slots of a wide node, for j up to
+/// eight; top down, the root then takes the cheapest plan and each node's slots are shared
+/// out as planned. Costs are in units of a node visit times its box's half area; a leaf
+/// costs as [`LeafSize`] says.
+struct Binary {
+    bounds: Aabb,
+    start: u32,
+    count: u32,
+    children: Option<Box<[Binary; 2]>>,
+    /// `cost[j - 1]`: the subtree's least cost in at most `j` slots.
+    cost: [f32; WIDTH],
+    /// `split[j - 1]`: how many of those `j` slots the first child's subtree takes in the
+    /// cheapest plan, or 0 where the subtree takes one slot.
+    split: [u8; WIDTH],
+    /// In one slot: a leaf, or else a node whose eight slots the children share as
+    /// `node_split` says.
+    leaf: bool,
+    node_split: u8,
+}
+
+impl Binary {
+    fn planned(
+        bounds: Aabb,
+        start: usize,
+        count: usize,
+        children: Option<Box<[Binary; 2]>>,
+        leaf: &LeafSize,
+    ) -> Binary {
+        let area = bounds.half_area();
+        let leaf_cost = if count <= leaf.max_leaf {
+            let blocks = count.div_ceil(leaf.block) as f32;
+            area * (leaf.leaf_cost + leaf.block_cost * (blocks - 1.0))
+        } else {
+            f32::INFINITY
+        };
+        let mut plan = Binary {
+            bounds,
+            start: start as u32,
+            count: count as u32,
+            children: None,
+            cost: [leaf_cost; WIDTH],
+            split: [0; WIDTH],
+            leaf: true,
+            node_split: 0,
+        };
+        let Some(children) = children else {
+            return plan;
+        };
+        let [first, second] = &*children;
+        // The least cost in j slots, at least one for each child, and the first one's share.
+        let mut shared = [(f32::INFINITY, 0u8); WIDTH];
+        for j in 2..=WIDTH {
+            for k in 1..j {
+                let cost = first.cost[k - 1] + second.cost[j - k - 1];
+                if cost < shared[j - 1].0 {
+                    shared[j - 1] = (cost, k as u8);
+                }
+            }
+        }
+        let node_cost = area + shared[WIDTH - 1].0;
+        plan.leaf = leaf_cost <= node_cost;
+        plan.node_split = shared[WIDTH - 1].1;
+        let one_slot = leaf_cost.min(node_cost);
+        for j in 1..=WIDTH {
+            (plan.cost[j - 1], plan.split[j - 1]) = if shared[j - 1].0 < one_slot {
+                shared[j - 1]
+            } else {
+                (one_slot, 0)
+            };
+        }
+        plan.children = Some(children);
+        plan
+    }
+
+    /// The subtree in one slot, as planned: a leaf, or a node.
+    fn into_wide(self) -> BuildNode {
+        match self.children {
+            Some(children) if !self.leaf => {
+                let mut slots = Vec::with_capacity(WIDTH);
+                let [first, second] = *children;
+                let k = self.node_split as usize;
+                first.into_slots(k, &mut slots);
+                second.into_slots(WIDTH - k, &mut slots);
+                BuildNode::Inner {
+                    bounds: self.bounds,
+                    children: slots,
+                }
+            }
+            _ => BuildNode::Leaf {
+                bounds: self.bounds,
+                start: self.start,
+                count: self.count,
+            },
+        }
+    }
+
+    /// Appends the subtree as planned for at most `slots` slots.
+    fn into_slots(mut self, slots: usize, out: &mut Vec<BuildNode>) {
+        let k = self.split[slots - 1] as usize;
+        match self.children.take() {
+            Some(children) if k > 0 => {
+                let [first, second] = *children;
+                first.into_slots(k, out);
+                second.into_slots(slots - k, out);
+            }
+            children => {
+                self.children = children;
+                out.push(self.into_wide());
+            }
+        }
+    }
 }
 
 /// Moves the items satisfying `pred` to the front; returns how many there are.
@@ -1100,34 +1075,88 @@ fn partition<T>(items: &mut [T], pred: impl Fn(&T) -> bool) -> usize {
 mod tests {
     use super::*;
 
-    fn leaf(x: f32, start: u32) -> BuildNode {
-        BuildNode::Leaf {
-            bounds: Aabb {
-                lo: [x, 0.0, 0.0],
-                hi: [x + 1.0, 1.0, 1.0],
-            },
-            start,
-            count: 4,
+    /// Leaves of at most `max_leaf` items, `block` to a test, each test costing a node visit.
+    fn sizes(max_leaf: usize, block: usize) -> LeafSize {
+        LeafSize {
+            max_leaf,
+            block,
+            leaf_cost: 1.0,
+            block_cost: 1.0,
         }
     }
 
-    fn inner(children: Vec<BuildNode>) -> BuildNode {
-        let mut bounds = Aabb::EMPTY;
-        for c in &children {
-            bounds.grow(&c.bounds().lo, &c.bounds().hi);
-        }
-        BuildNode::Inner { bounds, children }
+    /// What a leaf of `count` items costs in the plan, for a box of half area `area`.
+    fn leaf_cost(area: f32, count: usize, leaf: &LeafSize) -> f32 {
+        area * (leaf.leaf_cost + leaf.block_cost * (count.div_ceil(leaf.block) as f32 - 1.0))
     }
 
-    fn starts(node: &BuildNode) -> Vec<u32> {
+    /// The cost of a wide subtree, worked out from the tree itself.
+    fn wide_cost(node: &BuildNode, leaf: &LeafSize) -> f32 {
         match node {
-            BuildNode::Leaf { start, .. } => vec![*start],
-            BuildNode::Inner { children, .. } => {
-                let mut s: Vec<u32> = children.iter().flat_map(starts).collect();
-                s.sort();
-                s
+            BuildNode::Leaf { bounds, count, .. } => {
+                leaf_cost(bounds.half_area(), *count as usize, leaf)
+            }
+            BuildNode::Inner { bounds, children } => {
+                bounds.half_area() + children.iter().map(|c| wide_cost(c, leaf)).sum::<f32>()
             }
         }
+    }
+
+    /// Every collapse of a binary subtree into wide slots, as (cost, slots), by exhaustive
+    /// enumeration: a leaf where it may be one; each collapse of the first child beside each
+    /// of the second's; and a node over the cheapest of those that fit in its slots.
+    fn every_collapse(node: &Binary, leaf: &LeafSize) -> Vec<(f32, usize)> {
+        let area = node.bounds.half_area();
+        let mut all = Vec::new();
+        if node.count as usize <= leaf.max_leaf {
+            all.push((leaf_cost(area, node.count as usize, leaf), 1));
+        }
+        if let Some(children) = &node.children {
+            let second = every_collapse(&children[1], leaf);
+            let mut fitting = f32::INFINITY;
+            for (a, m) in every_collapse(&children[0], leaf) {
+                for &(b, n) in &second {
+                    if m + n <= WIDTH {
+                        all.push((a + b, m + n));
+                        fitting = fitting.min(a + b);
+                    }
+                }
+            }
+            all.push((area + fitting, 1));
+        }
+        all
+    }
+
+    /// `n` boxes at random (a fixed linear congruential sequence from `seed`) in the unit
+    /// cube, of sizes from 0.01 to 0.3.
+    fn random_boxes(n: usize, seed: u64) -> Vec<Bounds3> {
+        use crate::math::Vec3;
+        let mut state = seed;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as f64 / (1u64 << 24) as f64
+        };
+        (0..n)
+            .map(|_| {
+                let c = Vec3::new(next(), next(), next());
+                let size = Vec3::new(next(), next(), next()) * 0.29 + Vec3::ONE * 0.01;
+                Bounds3::new(c, c + size)
+            })
+            .collect()
+    }
+
+    fn items_of(boxes: &[Bounds3]) -> Vec<Item> {
+        boxes
+            .iter()
+            .enumerate()
+            .map(|(i, b)| Item {
+                lo: [0, 1, 2].map(|a| b.min[a] as f32),
+                hi: [0, 1, 2].map(|a| b.max[a] as f32),
+                index: i as u32,
+            })
+            .collect()
     }
 
     /// Boxes along a noisy curve, so leaves of every size occur.
@@ -1149,12 +1178,12 @@ mod tests {
         // cube's 3. Tested one at a time, the pair is worth splitting: one node (the root,
         // crossed by every ray) and two leaves of one block, each crossed by 3/21 of rays.
         let cube = |x: f64| Bounds3::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 1.0, 1.0));
-        let bvh = Bvh::build(&[cube(0.0), cube(9.0)], 8, 1);
+        let bvh = Bvh::build(&[cube(0.0), cube(9.0)], sizes(8, 1));
         let cost = bvh.sah_cost(1);
         assert!((cost.nodes - 1.0).abs() < 1e-6, "{cost:?}");
         assert!((cost.leaves - 6.0 / 21.0).abs() < 1e-6, "{cost:?}");
         // Tested four at a time, one leaf of one block holds both: splitting saves nothing.
-        let bvh = Bvh::build(&[cube(0.0), cube(9.0)], 8, 4);
+        let bvh = Bvh::build(&[cube(0.0), cube(9.0)], sizes(8, 4));
         assert_eq!(
             bvh.sah_cost(4),
             SahCost {
@@ -1162,7 +1191,7 @@ mod tests {
                 leaves: 1.0
             }
         );
-        assert_eq!(Bvh::build(&[], 8, 4).sah_cost(4), SahCost::default());
+        assert_eq!(Bvh::build(&[], sizes(8, 4)).sah_cost(4), SahCost::default());
     }
 
     #[test]
@@ -1177,7 +1206,7 @@ mod tests {
                 Bounds3::new(c, c + Vec3::ONE)
             })
             .collect();
-        let bvh = Bvh::build(&boxes, 1, 1);
+        let bvh = Bvh::build(&boxes, sizes(1, 1));
         for (origin, direction) in [(-5.0, 1.0), (500.0, -1.0)] {
             let ray = Ray::new(
                 Vec3::new(origin, 0.55, 0.55),
@@ -1213,7 +1242,7 @@ mod tests {
     #[test]
     fn padded_order_starts_every_leaf_on_a_block() {
         let boxes = curve_boxes();
-        let mut bvh = Bvh::build(&boxes, 8, 4);
+        let mut bvh = Bvh::build(&boxes, sizes(8, 4));
         let order = bvh.take_padded_order(4);
         assert_eq!(order.len() % 4, 0);
         let mut seen = vec![0; boxes.len()];
@@ -1266,7 +1295,7 @@ mod tests {
     fn embedded_blocks_follow_their_node_and_are_visited_as_before() {
         use crate::math::Vec3;
         let boxes = curve_boxes();
-        let mut bvh = Bvh::build(&boxes, 8, 4);
+        let mut bvh = Bvh::build(&boxes, sizes(8, 4));
         let order = bvh.take_padded_order(4);
         // Blocks of four item numbers: 16 bytes, one unit.
         let blocks: Vec<[u32; 4]> = order.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
@@ -1354,28 +1383,73 @@ mod tests {
     }
 
     #[test]
-    fn fill_merges_neighbouring_part_empty_nodes_and_opens_what_fits() {
-        // Two nodes of three leaves side by side: merged, then opened into the root.
-        let mut root = inner(vec![
-            inner((0..3).map(|i| leaf(i as f32, 4 * i)).collect()),
-            inner((3..6).map(|i| leaf(i as f32, 4 * i)).collect()),
-        ]);
-        root.fill();
-        let BuildNode::Inner { children, .. } = &root else {
-            panic!("the root stays a node");
+    fn the_collapse_is_the_cheapest_there_is() {
+        // Against every collapse, enumerated, of small random sets, for each number of slots
+        // up to eight; leaves of up to 8 items in blocks of 4 (as a mesh's) and up to 4
+        // items one by one (as a scene's).
+        let mesh = LeafSize {
+            leaf_cost: 1.25,
+            block_cost: 0.25,
+            ..sizes(8, 4)
         };
-        assert_eq!(children.len(), 6);
-        assert!(children.iter().all(|c| matches!(c, BuildNode::Leaf { .. })));
-        // Far apart, two such nodes would cost more merged than apart: they are opened
-        // into the root instead only while the slots allow, and no leaf is lost.
-        let far =
-            |x: f32, first: u32| inner((0..5).map(|i| leaf(x + i as f32, first + 4 * i)).collect());
-        let mut root = inner(vec![far(0.0, 0), far(1000.0, 20), far(2000.0, 40)]);
-        root.fill();
-        assert_eq!(starts(&root), (0..15).map(|i| 4 * i).collect::<Vec<u32>>());
-        let BuildNode::Inner { children, .. } = &root else {
-            panic!("the root stays a node");
+        for (seed, n) in [(1, 3), (2, 7), (3, 10), (4, 12), (5, 12)] {
+            for leaf in [mesh, sizes(4, 1)] {
+                let mut items = items_of(&random_boxes(n, seed));
+                let root = Builder { leaf }.build(&mut items, 0, 0);
+                let all = every_collapse(&root, &leaf);
+                for j in 1..=WIDTH {
+                    let least = all
+                        .iter()
+                        .filter(|&&(_, slots)| slots <= j)
+                        .map(|&(cost, _)| cost)
+                        .fold(f32::INFINITY, f32::min);
+                    let planned = root.cost[j - 1];
+                    assert!(
+                        (planned - least).abs() <= 1e-5 * least,
+                        "seed {seed}, {j} slots: planned {planned}, least {least}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_wide_tree_is_the_plan() {
+        // The tree made costs what its plan said, holds every item once, in leaves of at
+        // most `max_leaf` and nodes of at most eight.
+        fn check(node: &BuildNode, max_leaf: usize, items: &mut Vec<u32>) {
+            match node {
+                BuildNode::Leaf { start, count, .. } => {
+                    assert!((1..=max_leaf as u32).contains(count));
+                    items.extend(*start..start + count);
+                }
+                BuildNode::Inner { children, .. } => {
+                    assert!((1..=WIDTH).contains(&children.len()));
+                    for c in children {
+                        check(c, max_leaf, items);
+                    }
+                }
+            }
+        }
+        let leaf = LeafSize {
+            leaf_cost: 1.25,
+            block_cost: 0.25,
+            ..sizes(8, 4)
         };
-        assert!(children.len() <= WIDTH);
+        for boxes in [curve_boxes(), random_boxes(5000, 9)] {
+            let mut items = items_of(&boxes);
+            let root = Builder { leaf }.build(&mut items, 0, 0);
+            let planned = root.cost[0];
+            let wide = root.into_wide();
+            let cost = wide_cost(&wide, &leaf);
+            assert!(
+                (cost - planned).abs() <= 1e-4 * planned,
+                "{cost} against {planned}"
+            );
+            let mut seen = Vec::new();
+            check(&wide, 8, &mut seen);
+            seen.sort();
+            assert_eq!(seen, (0..boxes.len() as u32).collect::<Vec<_>>());
+        }
     }
 }

@@ -133,18 +133,23 @@ impl std::str::FromStr for AccelKind {
 }
 
 /// How the caller tests a leaf's items: at most `max_leaf` per BVH leaf, `block` at a time
-/// (four triangles share one SIMD test).
+/// (four triangles share one SIMD test). A leaf costs the BVH's build `leaf_cost`, and
+/// `block_cost` more for each block past its first, in units of a node visit.
 #[derive(Clone, Copy, Debug)]
 pub struct LeafSize {
     pub max_leaf: usize,
     pub block: usize,
+    pub leaf_cost: f32,
+    pub block_cost: f32,
 }
 
 impl LeafSize {
-    /// Items tested one by one (scene primitives).
+    /// Items tested one by one (scene primitives), each test as costly as a node visit.
     pub const SINGLE: LeafSize = LeafSize {
         max_leaf: 4,
         block: 1,
+        leaf_cost: 1.0,
+        block_cost: 1.0,
     };
 }
 
@@ -184,7 +189,7 @@ impl Accel {
         reaches: Option<Reaches>,
     ) -> Accel {
         match kind {
-            AccelKind::Bvh => Accel::Bvh(Bvh::build(item_bounds, leaf.max_leaf, leaf.block)),
+            AccelKind::Bvh => Accel::Bvh(Bvh::build(item_bounds, leaf)),
             AccelKind::Grid => Accel::Grid(Grid::build(item_bounds, leaf.block, reaches)),
             AccelKind::Octree => Accel::Octree(Octree::build(item_bounds, leaf.block, reaches)),
             AccelKind::None => Accel::None(BruteForce::build(item_bounds)),
