@@ -997,8 +997,9 @@ impl Binary {
             return plan;
         };
         let [first, second] = &*children;
-        // The least cost in j slots, at least one for each child, and the first one's share.
-        let mut shared = [(f32::INFINITY, 0u8); WIDTH];
+        // The least cost in j slots, at least one for each child, and the first one's share
+        // (one slot where no cost is finite: boxes too large for f32 areas).
+        let mut shared = [(f32::INFINITY, 1u8); WIDTH];
         for j in 2..=WIDTH {
             for k in 1..j {
                 let cost = first.cost[k - 1] + second.cost[j - k - 1];
@@ -1008,11 +1009,11 @@ impl Binary {
             }
         }
         let node_cost = area + shared[WIDTH - 1].0;
-        plan.leaf = leaf_cost <= node_cost;
+        plan.leaf = count <= leaf.max_leaf && leaf_cost <= node_cost;
         plan.node_split = shared[WIDTH - 1].1;
-        let one_slot = leaf_cost.min(node_cost);
+        let one_slot = if plan.leaf { leaf_cost } else { node_cost };
         for j in 1..=WIDTH {
-            (plan.cost[j - 1], plan.split[j - 1]) = if shared[j - 1].0 < one_slot {
+            (plan.cost[j - 1], plan.split[j - 1]) = if j > 1 && shared[j - 1].0 < one_slot {
                 shared[j - 1]
             } else {
                 (one_slot, 0)
@@ -1413,6 +1414,28 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn boxes_too_large_for_f32_areas_still_make_a_tree() {
+        use crate::math::Vec3;
+        // Areas overflow to infinity (and 0 · ∞ to NaN): every plan costs the same, and the
+        // tree must still hold each item once, in leaves it can name.
+        let boxes: Vec<Bounds3> = (0..100)
+            .map(|i| {
+                let c = Vec3::new(i as f64 * 1e36, 0.0, 0.0);
+                Bounds3::new(c - Vec3::ONE * 1e38, c + Vec3::ONE * 1e38)
+            })
+            .collect();
+        let bvh = Bvh::build(&boxes, sizes(4, 1));
+        let ray = Ray::new(Vec3::new(0.0, 0.0, -3e38), Vec3::new(0.0, 0.0, 1.0));
+        let mut seen = Vec::new();
+        bvh.traverse(&ray, f64::INFINITY, |items, _| {
+            seen.extend_from_slice(items);
+            true
+        });
+        seen.sort();
+        assert_eq!(seen, (0..100).collect::<Vec<u32>>());
     }
 
     #[test]
