@@ -1,8 +1,9 @@
 //! An eight-wide bounding-volume hierarchy: a binary binned surface-area-heuristic build
 //! (Wald 2007) over all three axes, parallel across subtrees, collapsed into nodes of up to
-//! eight children at the least SAH cost (Ylitie, Karras and Laine 2017); compact f32 nodes tested eight boxes at a time with AVX where
-//! the CPU has it (detected at run time) and as two four-box SSE tests otherwise; ordered
-//! front-to-back traversal with a fixed-size stack (no allocation per ray).
+//! eight children at the least SAH cost (Ylitie, Karras and Laine 2017); compact f32 nodes
+//! tested eight boxes at a time with AVX where the CPU has it (detected at run time) and as
+//! two four-box SSE tests otherwise; ordered front-to-back traversal with a fixed-size
+//! stack (no allocation per ray).
 //!
 //! The BVH knows only boxes. Its leaves are runs of item indices handed to the caller's
 //! closure, so one structure serves the triangles of a mesh (tested four at once) and the
@@ -30,8 +31,9 @@ const BINS: usize = 16;
 const WIDTH: usize = 8;
 /// Depth (in binary splits) past which runs are halved instead of split by cost.
 const MAX_DEPTH: usize = 64;
-/// A node pushes at most seven children. Nodes sit at most MAX_DEPTH / 2 levels deep where
-/// splits are binned, and then at most 31 levels more, as every level halves the items.
+/// A node pushes at most seven children. Each wide node is at least one binary split below
+/// its parent; splits are binned down to MAX_DEPTH levels, then at most 31 levels more, as
+/// every level halves the items.
 const STACK: usize = 7 * (MAX_DEPTH + 32);
 /// Subtrees with more items than this are built in parallel.
 const PARALLEL_ITEMS: usize = 4096;
@@ -188,9 +190,10 @@ impl Bvh {
     /// Builds over items given by their bounds, for a caller that tests leaves as `leaf`
     /// says; the leaves refer to items by position. Empty boxes are left out.
     pub fn build(item_bounds: &[Bounds3], leaf: LeafSize) -> Bvh {
+        let max_leaf = leaf.max_leaf.clamp(1, MAX_LEAF_ITEMS);
         let leaf = LeafSize {
-            max_leaf: leaf.max_leaf.clamp(1, MAX_LEAF_ITEMS),
-            block: leaf.block.clamp(1, leaf.max_leaf.clamp(1, MAX_LEAF_ITEMS)),
+            max_leaf,
+            block: leaf.block.clamp(1, max_leaf),
             ..leaf
         };
         let mut items: Vec<Item> = item_bounds
