@@ -945,7 +945,7 @@ impl Builder {
 
     /// Blocks that `n` items fill.
     fn leaf_blocks(&self, n: usize) -> f32 {
-        n.div_ceil(self.leaf.block) as f32
+        self.leaf.blocks(n) as f32
     }
 }
 
@@ -981,8 +981,7 @@ impl Binary {
     ) -> Binary {
         let area = bounds.half_area();
         let leaf_cost = if count <= leaf.max_leaf {
-            let blocks = count.div_ceil(leaf.block) as f32;
-            area * (leaf.leaf_cost + leaf.block_cost * (blocks - 1.0))
+            area * leaf.cost(count)
         } else {
             f32::INFINITY
         };
@@ -1049,19 +1048,17 @@ impl Binary {
     }
 
     /// Appends the subtree as planned for at most `slots` slots.
-    fn into_slots(mut self, slots: usize, out: &mut Vec<BuildNode>) {
+    fn into_slots(self, slots: usize, out: &mut Vec<BuildNode>) {
         let k = self.split[slots - 1] as usize;
-        match self.children.take() {
-            Some(children) if k > 0 => {
-                let [first, second] = *children;
-                first.into_slots(k, out);
-                second.into_slots(slots - k, out);
-            }
-            children => {
-                self.children = children;
-                out.push(self.into_wide());
-            }
+        if k == 0 {
+            out.push(self.into_wide());
+            return;
         }
+        let [first, second] = *self
+            .children
+            .expect("slots are shared only between children");
+        first.into_slots(k, out);
+        second.into_slots(slots - k, out);
     }
 }
 
@@ -1091,16 +1088,11 @@ mod tests {
         }
     }
 
-    /// What a leaf of `count` items costs in the plan, for a box of half area `area`.
-    fn leaf_cost(area: f32, count: usize, leaf: &LeafSize) -> f32 {
-        area * (leaf.leaf_cost + leaf.block_cost * (count.div_ceil(leaf.block) as f32 - 1.0))
-    }
-
     /// The cost of a wide subtree, worked out from the tree itself.
     fn wide_cost(node: &BuildNode, leaf: &LeafSize) -> f32 {
         match node {
             BuildNode::Leaf { bounds, count, .. } => {
-                leaf_cost(bounds.half_area(), *count as usize, leaf)
+                bounds.half_area() * leaf.cost(*count as usize)
             }
             BuildNode::Inner { bounds, children } => {
                 bounds.half_area() + children.iter().map(|c| wide_cost(c, leaf)).sum::<f32>()
@@ -1115,7 +1107,7 @@ mod tests {
         let area = node.bounds.half_area();
         let mut all = Vec::new();
         if node.count as usize <= leaf.max_leaf {
-            all.push((leaf_cost(area, node.count as usize, leaf), 1));
+            all.push((area * leaf.cost(node.count as usize), 1));
         }
         if let Some(children) = &node.children {
             let second = every_collapse(&children[1], leaf);

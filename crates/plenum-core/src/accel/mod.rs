@@ -151,6 +151,16 @@ impl LeafSize {
         leaf_cost: 1.0,
         block_cost: 1.0,
     };
+
+    /// The blocks that `n` items fill.
+    pub fn blocks(&self, n: usize) -> usize {
+        n.div_ceil(self.block)
+    }
+
+    /// What testing a leaf of `n` items costs, in node visits.
+    pub fn cost(&self, n: usize) -> f32 {
+        self.leaf_cost + self.block_cost * (self.blocks(n) as f32 - 1.0)
+    }
 }
 
 /// For the structures that file items in cells (the grid and the octree), a finer test
