@@ -304,10 +304,14 @@ impl Grid {
         if self.starts.last() == Some(&0) {
             return;
         }
-        let walk = Walk::new(self, ray);
-        let Some((t_enter, t_exit)) = self.region.intersect(ray, walk.inv_dir, t_max) else {
+        // The only divisions per ray.
+        let d = ray.direction;
+        let inv_dir = Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+        // Many rays miss the region: before the walk's set-up.
+        let Some((t_enter, t_exit)) = self.region.intersect(ray, inv_dir, t_max) else {
             return;
         };
+        let walk = Walk::new(self, ray, inv_dir);
         let mut limit = t_max.min(t_exit);
         let p = ray.at(t_enter);
         let mut cell = [0; 3];
@@ -447,12 +451,10 @@ struct Walk {
 }
 
 impl Walk {
-    fn new(grid: &Grid, ray: &Ray) -> Walk {
+    fn new(grid: &Grid, ray: &Ray, inv_dir: Vec3) -> Walk {
         let [nx, ny, _] = grid.resolution;
         let d = ray.direction;
         let step = [0, 1, 2].map(|a| (d[a] > 0.0) as isize - (d[a] < 0.0) as isize);
-        // The only divisions per ray.
-        let inv_dir = Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
         let [mx, my, _] = grid.macro_resolution;
         let strides = [1, nx as isize, (nx * ny) as isize];
         let macro_strides = [1, mx as isize, (mx * my) as isize];
