@@ -321,6 +321,7 @@ impl Grid {
         let mut next = walk.walls(self, cell, 1);
         let mut block = cell.map(|x| x / MACRO);
         let mut block_next = walk.walls(self, block, MACRO);
+        let mut stop = [0, 1, 2].map(|a| self.stop(block[a], a, &walk));
         let mut m = self.macro_index(cell);
         // The cell walk is under way inside the current macro cell; when not, the ray
         // entered this macro cell at `t_block` through a wall across `entered_along`.
@@ -331,6 +332,7 @@ impl Grid {
                 if !walking {
                     cell = self.entry_cell(ray.at(t_block), block, entered_along, &walk);
                     next = walk.walls(self, cell, 1);
+                    stop = [0, 1, 2].map(|a| self.stop(block[a], a, &walk));
                     walking = true;
                 }
                 let mut c = self.index(cell);
@@ -351,59 +353,71 @@ impl Grid {
                         }
                         limit = t_max.min(t_exit);
                     }
-                    // One step across the nearest wall, by selects over fixed indices:
-                    // indexing by the axis would keep the walk's state in memory, a chain
-                    // of stores and reloads from one step to the next.
                     let (a, t) = nearest(next);
                     if t > limit {
                         return;
                     }
-                    for i in 0..3 {
-                        let on = a == i;
-                        cell[i] = if on {
-                            cell[i].wrapping_add_signed(walk.step[i])
-                        } else {
-                            cell[i]
-                        };
-                        next[i] = if on { next[i] + walk.delta[i] } else { next[i] };
-                        c = if on {
-                            c.wrapping_add_signed(walk.stride[i])
-                        } else {
-                            c
-                        };
-                    }
-                    // Below zero wraps to beyond the grid.
-                    let outside = (cell[0] >= self.resolution[0])
-                        | (cell[1] >= self.resolution[1])
-                        | (cell[2] >= self.resolution[2]);
-                    if outside {
-                        return;
-                    }
-                    let left = (cell[0] / MACRO != block[0])
-                        | (cell[1] / MACRO != block[1])
-                        | (cell[2] / MACRO != block[2]);
+                    // One step across the nearest wall. Each axis has its own arm, with
+                    // its own state held in registers: which arm is taken is a coin toss,
+                    // but selects over all three axes, or state indexed by the axis (kept
+                    // in memory), run more instructions and are slower.
+                    let mut advance = |i: usize| {
+                        cell[i] = cell[i].wrapping_add_signed(walk.step[i]);
+                        next[i] += walk.delta[i];
+                        c = c.wrapping_add_signed(walk.stride[i]);
+                        cell[i] == stop[i]
+                    };
+                    let left = match a {
+                        0 => advance(0),
+                        1 => advance(1),
+                        _ => advance(2),
+                    };
                     if left {
                         break a;
                     }
                 };
-                // The cell walk carries on in the neighbouring macro cell.
+                // The cell walk carries on in the neighbouring macro cell, if the grid
+                // goes on (below zero wraps to beyond it).
+                if cell[a] >= self.resolution[a] {
+                    return;
+                }
                 block[a] = block[a].wrapping_add_signed(walk.step[a]);
-                block_next[a] += walk.delta[a] * MACRO as f64;
+                block_next[a] += walk.macro_delta[a];
+                stop[a] = self.stop(block[a], a, &walk);
                 m = m.wrapping_add_signed(walk.macro_stride[a]);
             } else {
                 let (a, t) = nearest(block_next);
                 if t > limit {
                     return;
                 }
-                block[a] = block[a].wrapping_add_signed(walk.step[a]);
-                if block[a] >= self.macro_resolution[a] {
+                // As in the cell walk, an arm per axis.
+                let mut advance = |i: usize| {
+                    block[i] = block[i].wrapping_add_signed(walk.step[i]);
+                    block_next[i] += walk.macro_delta[i];
+                    m = m.wrapping_add_signed(walk.macro_stride[i]);
+                    block[i] >= self.macro_resolution[i]
+                };
+                let outside = match a {
+                    0 => advance(0),
+                    1 => advance(1),
+                    _ => advance(2),
+                };
+                if outside {
                     return;
                 }
-                m = m.wrapping_add_signed(walk.macro_stride[a]);
                 (t_block, entered_along) = (t, a);
-                block_next[a] += walk.delta[a] * MACRO as f64;
                 walking = false;
             }
+        }
+    }
+
+    /// The first cell along axis `a` past macro cell `block` the way the ray steps: in the
+    /// next macro cell, or just outside the grid (`usize::MAX` below it).
+    fn stop(&self, block: usize, a: usize, walk: &Walk) -> usize {
+        if walk.step[a] > 0 {
+            ((block + 1) * MACRO).min(self.resolution[a])
+        } else {
+            (block * MACRO).wrapping_sub(1)
         }
     }
 
@@ -446,8 +460,9 @@ struct Walk {
     /// The change of the cell index per step along each axis, and of the macro cell index.
     stride: [isize; 3],
     macro_stride: [isize; 3],
-    /// The time between walls along each axis.
+    /// The time between walls along each axis, of cells and of macro cells.
     delta: [f64; 3],
+    macro_delta: [f64; 3],
 }
 
 impl Walk {
@@ -458,16 +473,18 @@ impl Walk {
         let [mx, my, _] = grid.macro_resolution;
         let strides = [1, nx as isize, (nx * ny) as isize];
         let macro_strides = [1, mx as isize, (mx * my) as isize];
+        let delta = [0, 1, 2].map(|a| match step[a] {
+            0 => f64::INFINITY,
+            _ => (grid.cell_size[a] * inv_dir[a]).abs(),
+        });
         Walk {
             origin: ray.origin,
             inv_dir,
             step,
             stride: [0, 1, 2].map(|a| step[a] * strides[a]),
             macro_stride: [0, 1, 2].map(|a| step[a] * macro_strides[a]),
-            delta: [0, 1, 2].map(|a| match step[a] {
-                0 => f64::INFINITY,
-                _ => (grid.cell_size[a] * inv_dir[a]).abs(),
-            }),
+            delta,
+            macro_delta: delta.map(|d| d * MACRO as f64),
         }
     }
 
