@@ -175,6 +175,7 @@ impl Grid {
 
     /// The cell of a point along one axis, clamped to the grid.
     /// Along a flat axis the inverse cell size is 0, which puts every point in its one cell.
+    #[inline(always)]
     fn cell_of(&self, x: f64, axis: usize) -> usize {
         // Truncation is floor here (c ≥ 0), without a call into libm; a signed conversion
         // is one instruction, and the clamp keeps it in range.
@@ -313,26 +314,29 @@ impl Grid {
         };
         let walk = Walk::new(self, ray, inv_dir);
         let mut limit = t_max.min(t_exit);
+        // The cell walk starts only in a macro cell that holds anything (most rays enter
+        // the region through empty ones).
         let p = ray.at(t_enter);
-        let mut cell = [0; 3];
+        let mut block = [0; 3];
         for a in 0..3 {
-            cell[a] = self.cell_of(p[a], a);
+            block[a] = self.cell_of(p[a], a) / MACRO;
         }
-        let mut next = walk.walls(self, cell, 1);
-        let mut block = cell.map(|x| x / MACRO);
         let mut block_next = walk.walls(self, block, MACRO);
-        let mut stop = [0, 1, 2].map(|a| self.stop(block[a], a, &walk));
-        let mut m = self.macro_index(cell);
+        let mut m = self.macro_index(block);
+        let (mut cell, mut next, mut stop) = ([0; 3], [0.0; 3], [0; 3]);
         // The cell walk is under way inside the current macro cell; when not, the ray
-        // entered this macro cell at `t_block` through a wall across `entered_along`.
-        let mut walking = true;
-        let (mut t_block, mut entered_along) = (t_enter, 0);
+        // entered this macro cell at `t_block`, through a wall across `entered_along` (or
+        // none, 3, where it starts).
+        let mut walking = false;
+        let (mut t_block, mut entered_along) = (t_enter, 3);
         loop {
             if self.macro_full[m] {
                 if !walking {
                     cell = self.entry_cell(ray.at(t_block), block, entered_along, &walk);
                     next = walk.walls(self, cell, 1);
-                    stop = [0, 1, 2].map(|a| self.stop(block[a], a, &walk));
+                    for a in 0..3 {
+                        stop[a] = self.stop(block[a], a, &walk);
+                    }
                     walking = true;
                 }
                 let mut c = self.index(cell);
@@ -422,8 +426,10 @@ impl Grid {
     }
 
     /// The cell of macro cell `block` where a ray that entered it at `p` across a wall
-    /// along axis `entered` starts: on that axis the first row it meets, on the others
-    /// where `p` lies, kept within the macro cell against rounding.
+    /// along axis `entered` (or started in it, `entered` 3) starts: on that axis the first
+    /// row it meets, on the others where `p` lies, kept within the macro cell against
+    /// rounding.
+    #[inline(always)]
     fn entry_cell(&self, p: Vec3, block: [usize; 3], entered: usize, walk: &Walk) -> [usize; 3] {
         let mut cell = [0; 3];
         for a in 0..3 {
@@ -445,9 +451,9 @@ impl Grid {
         (cell[2] * ny + cell[1]) * nx + cell[0]
     }
 
-    fn macro_index(&self, cell: [usize; 3]) -> usize {
+    fn macro_index(&self, block: [usize; 3]) -> usize {
         let [mx, my, _] = self.macro_resolution;
-        ((cell[2] / MACRO) * my + cell[1] / MACRO) * mx + cell[0] / MACRO
+        (block[2] * my + block[1]) * mx + block[0]
     }
 }
 
@@ -466,26 +472,34 @@ struct Walk {
 }
 
 impl Walk {
+    #[inline(always)]
     fn new(grid: &Grid, ray: &Ray, inv_dir: Vec3) -> Walk {
         let [nx, ny, _] = grid.resolution;
-        let d = ray.direction;
-        let step = [0, 1, 2].map(|a| (d[a] > 0.0) as isize - (d[a] < 0.0) as isize);
         let [mx, my, _] = grid.macro_resolution;
         let strides = [1, nx as isize, (nx * ny) as isize];
         let macro_strides = [1, mx as isize, (mx * my) as isize];
-        let delta = [0, 1, 2].map(|a| match step[a] {
-            0 => f64::INFINITY,
-            _ => (grid.cell_size[a] * inv_dir[a]).abs(),
-        });
-        Walk {
+        let mut walk = Walk {
             origin: ray.origin,
             inv_dir,
-            step,
-            stride: [0, 1, 2].map(|a| step[a] * strides[a]),
-            macro_stride: [0, 1, 2].map(|a| step[a] * macro_strides[a]),
-            delta,
-            macro_delta: delta.map(|d| d * MACRO as f64),
+            step: [0; 3],
+            stride: [0; 3],
+            macro_stride: [0; 3],
+            delta: [f64::INFINITY; 3],
+            macro_delta: [f64::INFINITY; 3],
+        };
+        // Plain loops: an array's `map` here is left as a call.
+        for a in 0..3 {
+            let d = ray.direction[a];
+            let step = (d > 0.0) as isize - (d < 0.0) as isize;
+            walk.step[a] = step;
+            walk.stride[a] = step * strides[a];
+            walk.macro_stride[a] = step * macro_strides[a];
+            if step != 0 {
+                walk.delta[a] = (grid.cell_size[a] * inv_dir[a]).abs();
+                walk.macro_delta[a] = walk.delta[a] * MACRO as f64;
+            }
         }
+        walk
     }
 
     /// When the ray crosses wall `wall` (the low wall of that cell) along axis `a`.
