@@ -416,14 +416,10 @@ impl Octree {
                 let octant = p.octant;
                 let mut exit = [0.0; 3];
                 for a in 0..3 {
-                    let upper = octant >> a & 1 == 1;
-                    c0[a] = if upper { p.mid[a] } else { p.t0[a] };
-                    c1[a] = if upper { p.t1[a] } else { p.mid[a] };
-                    exit[a] = c1[a];
+                    exit[a] = if octant >> a & 1 == 1 { p.t1[a] } else { p.mid[a] };
                 }
-                start = p.enter;
+                let enter = p.enter;
                 let occupied = p.occupied >> (octant ^ flip) & 1 != 0;
-                let children = p.children;
                 // Next, the child across the nearest exit plane, unless that plane is the
                 // parent's own or lies beyond `t_max`: then the parent is left (its entry,
                 // written all the same, is dead). Without branches: which way it goes is a
@@ -432,8 +428,15 @@ impl Octree {
                 p.octant = octant | 1 << a;
                 p.enter = t;
                 top -= (octant >> a & 1) as usize | usize::from(t > t_max);
+                // An empty child costs only the step past it; an occupied one is entered,
+                // its planes taken from the parent's (still there when just left).
                 if occupied {
-                    index = children * 8 + (octant ^ flip);
+                    for a in 0..3 {
+                        c0[a] = if octant >> a & 1 == 1 { p.mid[a] } else { p.t0[a] };
+                    }
+                    c1 = exit;
+                    start = enter;
+                    index = p.children * 8 + (octant ^ flip);
                     break;
                 }
             }
