@@ -4,10 +4,14 @@
 //! mid-planes' are their averages, and from them the traversal knows, without testing
 //! boxes, which children the ray passes through and in what order, so the cells are
 //! visited front to back. Items filed in several cells are mailboxed.
+//!
+//! A leaf also keeps the box its items fill within its cell, and a ray that misses that
+//! box passes the leaf untested: leaves at the surface of a model are mostly empty space,
+//! which rays that pass the model close by cross (a tenth faster on the dragon's rays).
 
 use super::mailbox::{new_owner, Mailbox};
 use super::{append_padded, nearest, split_off_large, LargeSplit, Reaches};
-use crate::math::{Bounds3, Ray, Vec3};
+use crate::math::{gamma, Bounds3, Ray, Vec3};
 use std::mem::MaybeUninit;
 use std::ops::Range;
 
@@ -81,11 +85,32 @@ pub struct Octree {
     large_run: usize,
     /// Cell `id` is `blocks[id / 8].0[id % 8]`; the root is cell 0, alone in its block.
     blocks: Vec<Siblings>,
+    /// Per cell, for a leaf: the box its items fill within it, min then max, rounded out.
+    leaf_boxes: Vec<[f32; 6]>,
     items: Vec<u32>,
     /// Some cell holds an item.
     has_items: bool,
     item_count: usize,
     owner: u64,
+}
+
+/// The nearest f32 at or below `x`, and at or above.
+fn round_down(x: f64) -> f32 {
+    let y = x as f32;
+    if f64::from(y) > x {
+        y.next_down()
+    } else {
+        y
+    }
+}
+
+fn round_up(x: f64) -> f32 {
+    let y = x as f32;
+    if f64::from(y) < x {
+        y.next_up()
+    } else {
+        y
+    }
 }
 
 /// Child `octant`'s box: bit 0, 1, 2 set for the upper half in x, y, z.
@@ -123,6 +148,7 @@ impl Octree {
             large,
             large_run: 0,
             blocks: vec![EMPTY_BLOCK],
+            leaf_boxes: vec![[0.0; 6]; 8],
             items: Vec::new(),
             has_items: false,
             item_count: item_bounds.len(),
@@ -142,7 +168,7 @@ impl Octree {
             reaches,
             splitting,
         };
-        tree.build_node(0, lo, hi, bounded, 0, &filing);
+        tree.build_node(0, lo, hi, bounded, tree.region, 0, &filing);
         tree.has_items = !tree.items.is_empty();
         tree
     }
@@ -153,6 +179,7 @@ impl Octree {
         lo: Vec3,
         hi: Vec3,
         items: Vec<u32>,
+        fill: Bounds3,
         depth: usize,
         filing: &Filing,
     ) {
@@ -163,12 +190,22 @@ impl Octree {
                 info: LEAF | items.len() as u32,
             };
             tree.items.extend_from_slice(items);
+            let pad = filing.margin + 1e-6 * (hi - lo).max_component();
+            let cell = Bounds3::new(lo, hi).expanded(pad);
+            let mut b = [0.0f32; 6];
+            for a in 0..3 {
+                b[a] = round_down(fill.min[a].max(cell.min[a]));
+                b[a + 3] = round_up(fill.max[a].min(cell.max[a]));
+            }
+            tree.leaf_boxes[node] = b;
         };
         if items.len() <= splitting.leaf_items || depth >= MAX_DEPTH {
             return make_leaf(self, &items);
         }
         let mid = (lo + hi) * 0.5;
         let mut children: [Vec<u32>; 8] = Default::default();
+        // The box each child's items fill (gathered here, where each box is read anyway).
+        let mut fills = [Bounds3::default(); 8];
         for &i in &items {
             let b = &filing.boxes[i as usize];
             // Octants the box reaches into, and the axes along which it crosses the middle.
@@ -193,6 +230,7 @@ impl Octree {
                 };
                 if kept {
                     list.push(i);
+                    fills[octant] = fills[octant].union(b);
                 }
             }
         }
@@ -206,12 +244,13 @@ impl Octree {
         }
         let block = self.blocks.len();
         self.blocks.push(EMPTY_BLOCK);
+        self.leaf_boxes.resize(self.blocks.len() * 8, [0.0; 6]);
         drop(items);
         let mut occupied = 0;
-        for (octant, list) in children.into_iter().enumerate() {
+        for ((octant, list), fill) in children.into_iter().enumerate().zip(fills) {
             occupied |= u32::from(!list.is_empty()) << octant;
             let (clo, chi) = child_box(lo, hi, octant);
-            self.build_node(block * 8 + octant, clo, chi, list, depth + 1, filing);
+            self.build_node(block * 8 + octant, clo, chi, list, fill, depth + 1, filing);
         }
         *self.node_mut(node) = OctNode {
             first: block as u32,
@@ -233,6 +272,7 @@ impl Octree {
 
     pub fn memory_bytes(&self) -> usize {
         self.blocks.len() * std::mem::size_of::<Siblings>()
+            + self.leaf_boxes.len() * std::mem::size_of::<[f32; 6]>()
             + (self.items.len() + self.large.len()) * 4
     }
 
@@ -322,16 +362,37 @@ impl Octree {
         let mut flip = 0;
         let mut t0 = [0.0; 3];
         let mut t1 = [0.0; 3];
+        // For the leaves' boxes, which are not mirrored: where in a box's six numbers the
+        // near and the far side lie along each axis, and 1 / d with d's own sign.
+        let (mut near, mut far) = ([0, 1, 2], [3, 4, 5]);
+        let mut inv_dir = [0.0; 3];
         for a in 0..3 {
             let (mut o, mut d) = (ray.origin[a], ray.direction[a]);
-            if d < 0.0 {
+            let mirrored = d < 0.0;
+            if mirrored {
                 (o, d) = (lo[a] + hi[a] - o, -d);
                 flip |= 1 << a;
+                (near[a], far[a]) = (far[a], near[a]);
             }
             let inv = 1.0 / d.max(1e-200);
+            inv_dir[a] = if mirrored { -inv } else { inv };
             t0[a] = (lo[a] - o) * inv;
             t1[a] = (hi[a] - o) * inv;
         }
+        // Whether the ray, from `start` to `t_max`, misses the box leaf `id`'s items fill:
+        // the slab test, with the far distance rounded up as the BVH's is.
+        let leaf_missed = |id: usize, start: f64, t_max: f64| {
+            // SAFETY: there is a box per cell.
+            let b = unsafe { self.leaf_boxes.get_unchecked(id) };
+            let (mut enter, mut exit) = (start, t_max);
+            for a in 0..3 {
+                let n = (f64::from(b[near[a]]) - ray.origin[a]) * inv_dir[a];
+                let f = (f64::from(b[far[a]]) - ray.origin[a]) * inv_dir[a];
+                enter = if n > enter { n } else { enter };
+                exit = if f < exit { f } else { exit };
+            }
+            enter > exit * (1.0 + 2.0 * gamma(3))
+        };
         // Plain comparisons: the distances are never NaN, so f64::max's NaN rules would only
         // cost instructions.
         let larger = |a: f64, b: f64| if a > b { a } else { b };
@@ -358,7 +419,9 @@ impl Octree {
             let node = self.node(index as usize);
             if node.info & LEAF != 0 {
                 let first = node.first as usize;
-                if !hand(first..first + (node.info & !LEAF) as usize, &mut t_max) {
+                if leaf_missed(index as usize, start, t_max) {
+                    // Nothing here: on to the next cell.
+                } else if !hand(first..first + (node.info & !LEAF) as usize, &mut t_max) {
                     return;
                 }
                 // Whatever is left is entered beyond this cell's exit.
@@ -416,7 +479,11 @@ impl Octree {
                 let octant = p.octant;
                 let mut exit = [0.0; 3];
                 for a in 0..3 {
-                    exit[a] = if octant >> a & 1 == 1 { p.t1[a] } else { p.mid[a] };
+                    exit[a] = if octant >> a & 1 == 1 {
+                        p.t1[a]
+                    } else {
+                        p.mid[a]
+                    };
                 }
                 let enter = p.enter;
                 let occupied = p.occupied >> (octant ^ flip) & 1 != 0;
@@ -432,7 +499,11 @@ impl Octree {
                 // its planes taken from the parent's (still there when just left).
                 if occupied {
                     for a in 0..3 {
-                        c0[a] = if octant >> a & 1 == 1 { p.mid[a] } else { p.t0[a] };
+                        c0[a] = if octant >> a & 1 == 1 {
+                            p.mid[a]
+                        } else {
+                            p.t0[a]
+                        };
                     }
                     c1 = exit;
                     start = enter;
@@ -521,5 +592,33 @@ mod tests {
             let short = handed(&tree, &from_outside, 2.9);
             assert!(short.iter().all(|&i| i >= 40), "{d:?}: {short:?}");
         }
+    }
+
+    /// Two items at each corner of a unit cube and four in a cluster at (0.3, 0.3, 0.3)
+    /// split the root once; the lower octant's leaf holds the cluster and one corner's
+    /// items, and the box they fill leaves most of its cell empty. A ray across that cell
+    /// through the empty part is handed nothing; one through the cluster is handed it.
+    #[test]
+    fn a_ray_that_misses_the_box_a_leafs_items_fill_is_handed_none_of_them() {
+        let small = |c: Vec3| Bounds3::new(c - Vec3::splat(0.01), c + Vec3::splat(0.01));
+        let mut boxes = Vec::new();
+        for k in 0..16 {
+            let k = k / 2;
+            boxes.push(small(Vec3::new(
+                (k & 1) as f64,
+                (k >> 1 & 1) as f64,
+                (k >> 2 & 1) as f64,
+            )));
+        }
+        boxes.extend([small(Vec3::splat(0.3)); 4]);
+        let tree = Octree::build(&boxes, 1, None);
+        assert_eq!(depth(&tree, 0), 1);
+        let along_x = |y: f64, z: f64| Ray::new(Vec3::new(-1.0, y, z), Vec3::X);
+        assert_eq!(
+            handed(&tree, &along_x(0.45, 0.45), f64::INFINITY),
+            Vec::<u32>::new()
+        );
+        let through = handed(&tree, &along_x(0.3, 0.3), f64::INFINITY);
+        assert!((16..20).all(|i| through.contains(&i)), "{through:?}");
     }
 }
