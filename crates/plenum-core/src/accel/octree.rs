@@ -34,6 +34,15 @@ struct Filing<'a> {
     splitting: Splitting,
 }
 
+impl Filing<'_> {
+    /// A cell grown as the grid grows its cells (see there), by the items' margin and a
+    /// little of its size more: what the finer test is asked of, and what bounds a leaf's
+    /// box.
+    fn grown(&self, cell: &Bounds3) -> Bounds3 {
+        cell.expanded(self.margin + 1e-6 * cell.diagonal().max_component())
+    }
+}
+
 /// For items tested one by one (a scene's primitives).
 const ONE_BY_ONE: Splitting = Splitting {
     leaf_items: 8,
@@ -114,10 +123,11 @@ fn round_up(x: f64) -> f32 {
 }
 
 /// Child `octant`'s box: bit 0, 1, 2 set for the upper half in x, y, z.
-fn child_box(lo: Vec3, hi: Vec3, octant: usize) -> (Vec3, Vec3) {
+fn child_box(cell: &Bounds3, octant: usize) -> Bounds3 {
+    let (lo, hi) = (cell.min, cell.max);
     let mid = (lo + hi) * 0.5;
     let pick = |a: usize, upper: f64, lower: f64| if octant >> a & 1 == 1 { upper } else { lower };
-    (
+    Bounds3::new(
         Vec3::new(
             pick(0, mid.x, lo.x),
             pick(1, mid.y, lo.y),
@@ -161,14 +171,13 @@ impl Octree {
         let margin = region.diagonal().max_component() * 1e-9;
         let filed: Vec<Bounds3> = item_bounds.iter().map(|b| b.expanded(margin)).collect();
         tree.region = region.expanded(margin);
-        let (lo, hi) = (tree.region.min, tree.region.max);
         let filing = Filing {
             boxes: &filed,
             margin,
             reaches,
             splitting,
         };
-        tree.build_node(0, lo, hi, bounded, tree.region, 0, &filing);
+        tree.build_node(0, tree.region, bounded, tree.region, 0, &filing);
         tree.has_items = !tree.items.is_empty();
         tree
     }
@@ -176,8 +185,7 @@ impl Octree {
     fn build_node(
         &mut self,
         node: usize,
-        lo: Vec3,
-        hi: Vec3,
+        cell: Bounds3,
         items: Vec<u32>,
         fill: Bounds3,
         depth: usize,
@@ -190,19 +198,18 @@ impl Octree {
                 info: LEAF | items.len() as u32,
             };
             tree.items.extend_from_slice(items);
-            let pad = filing.margin + 1e-6 * (hi - lo).max_component();
-            let cell = Bounds3::new(lo, hi).expanded(pad);
+            let grown = filing.grown(&cell);
             let mut b = [0.0f32; 6];
             for a in 0..3 {
-                b[a] = round_down(fill.min[a].max(cell.min[a]));
-                b[a + 3] = round_up(fill.max[a].min(cell.max[a]));
+                b[a] = round_down(fill.min[a].max(grown.min[a]));
+                b[a + 3] = round_up(fill.max[a].min(grown.max[a]));
             }
             tree.leaf_boxes[node] = b;
         };
         if items.len() <= splitting.leaf_items || depth >= MAX_DEPTH {
             return make_leaf(self, &items);
         }
-        let mid = (lo + hi) * 0.5;
+        let mid = cell.centroid();
         let mut children: [Vec<u32>; 8] = Default::default();
         // The box each child's items fill (gathered here, where each box is read anyway).
         let mut fills = [Bounds3::default(); 8];
@@ -221,10 +228,7 @@ impl Octree {
                 // Where the box lies in one octant, the item reaches into it.
                 let kept = match filing.reaches {
                     Some(reaches) if inside && straddles => {
-                        // Asked of the cell grown as the grid grows its cells (see there).
-                        let (clo, chi) = child_box(lo, hi, octant);
-                        let pad = filing.margin + 1e-6 * (chi - clo).max_component();
-                        reaches(i, &Bounds3::new(clo, chi).expanded(pad))
+                        reaches(i, &filing.grown(&child_box(&cell, octant)))
                     }
                     _ => inside,
                 };
@@ -249,8 +253,8 @@ impl Octree {
         let mut occupied = 0;
         for ((octant, list), fill) in children.into_iter().enumerate().zip(fills) {
             occupied |= u32::from(!list.is_empty()) << octant;
-            let (clo, chi) = child_box(lo, hi, octant);
-            self.build_node(block * 8 + octant, clo, chi, list, fill, depth + 1, filing);
+            let child = child_box(&cell, octant);
+            self.build_node(block * 8 + octant, child, list, fill, depth + 1, filing);
         }
         *self.node_mut(node) = OctNode {
             first: block as u32,
@@ -478,8 +482,8 @@ impl Octree {
                 }
                 let octant = p.octant;
                 let mut exit = [0.0; 3];
-                for a in 0..3 {
-                    exit[a] = if octant >> a & 1 == 1 {
+                for (a, e) in exit.iter_mut().enumerate() {
+                    *e = if octant >> a & 1 == 1 {
                         p.t1[a]
                     } else {
                         p.mid[a]
@@ -498,8 +502,8 @@ impl Octree {
                 // An empty child costs only the step past it; an occupied one is entered,
                 // its planes taken from the parent's (still there when just left).
                 if occupied {
-                    for a in 0..3 {
-                        c0[a] = if octant >> a & 1 == 1 {
+                    for (a, c) in c0.iter_mut().enumerate() {
+                        *c = if octant >> a & 1 == 1 {
                             p.mid[a]
                         } else {
                             p.t0[a]
