@@ -920,13 +920,13 @@ impl Builder {
             for i in (1..BINS).rev() {
                 acc.grow(&bins[i].lo, &bins[i].hi);
                 count += counts[i];
-                right_cost[i] = acc.half_area() * self.leaf_blocks(count);
+                right_cost[i] = acc.half_area() * self.leaf.blocks(count) as f32;
             }
             let (mut acc, mut count) = (Aabb::EMPTY, 0);
             for i in 0..BINS - 1 {
                 acc.grow(&bins[i].lo, &bins[i].hi);
                 count += counts[i];
-                let cost = acc.half_area() * self.leaf_blocks(count) + right_cost[i + 1];
+                let cost = acc.half_area() * self.leaf.blocks(count) as f32 + right_cost[i + 1];
                 if count > 0 && count < n && best.is_none_or(|b| cost < b.0) {
                     best = Some((cost, axis, i));
                 }
@@ -941,11 +941,6 @@ impl Builder {
         Some(partition(items, |it| {
             ((((it.center2(axis) - lo) * scale) as usize).min(BINS - 1)) <= last
         }))
-    }
-
-    /// Blocks that `n` items fill.
-    fn leaf_blocks(&self, n: usize) -> f32 {
-        self.leaf.blocks(n) as f32
     }
 }
 
