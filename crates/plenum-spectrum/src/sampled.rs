@@ -1,0 +1,240 @@
+//! Values at a few wavelengths at once: what a camera sample carries through the scene.
+//!
+//! In spectral mode a sample carries [`N_SAMPLES`] wavelengths, a hero wavelength and the
+//! others equally spaced from it across the visible range (Wilkie et al. 2014, "Hero
+//! Wavelength Spectral Sampling"). In RGB mode the same lanes hold red, green and blue (the
+//! last lane unused), so integrators and BSDFs are written once for both modes; only the
+//! evaluation of input spectra and the film's conversion differ.
+
+use std::ops::{Add, AddAssign, Div, DivAssign, Index, IndexMut, Mul, MulAssign, Neg, Sub};
+
+/// Wavelengths a sample carries.
+pub const N_SAMPLES: usize = 4;
+
+/// The visible range sampled, in nm.
+pub const LAMBDA_MIN: f64 = 360.0;
+pub const LAMBDA_MAX: f64 = 830.0;
+
+/// Spectral values (radiance, reflectance, a path's throughput) at the sample's wavelengths,
+/// or R, G, B and 0 in RGB mode.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SampledSpectrum(pub [f64; N_SAMPLES]);
+
+impl SampledSpectrum {
+    pub const ZERO: SampledSpectrum = SampledSpectrum([0.0; N_SAMPLES]);
+    pub const ONE: SampledSpectrum = SampledSpectrum([1.0; N_SAMPLES]);
+
+    pub const fn splat(v: f64) -> Self {
+        SampledSpectrum([v; N_SAMPLES])
+    }
+
+    pub fn map(self, f: impl Fn(f64) -> f64) -> Self {
+        SampledSpectrum(self.0.map(f))
+    }
+
+    pub fn zip(self, o: Self, f: impl Fn(f64, f64) -> f64) -> Self {
+        let mut r = self;
+        for i in 0..N_SAMPLES {
+            r.0[i] = f(self.0[i], o.0[i]);
+        }
+        r
+    }
+
+    pub fn is_black(&self) -> bool {
+        self.0.iter().all(|&v| v == 0.0)
+    }
+
+    pub fn max_value(&self) -> f64 {
+        self.0.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    pub fn min_value(&self) -> f64 {
+        self.0.iter().copied().fold(f64::INFINITY, f64::min)
+    }
+
+    pub fn average(&self) -> f64 {
+        self.0.iter().sum::<f64>() / N_SAMPLES as f64
+    }
+
+    /// Every value is finite (no NaN, no infinity).
+    pub fn is_finite(&self) -> bool {
+        self.0.iter().all(|v| v.is_finite())
+    }
+
+    /// self / o, with 0 wherever o is 0 (pbrt's `SafeDiv`).
+    pub fn safe_div(self, o: Self) -> Self {
+        self.zip(o, |a, b| if b != 0.0 { a / b } else { 0.0 })
+    }
+
+    pub fn sqrt(self) -> Self {
+        self.map(|v| v.max(0.0).sqrt())
+    }
+
+    pub fn exp(self) -> Self {
+        self.map(f64::exp)
+    }
+
+    pub fn clamp_zero(self) -> Self {
+        self.map(|v| v.max(0.0))
+    }
+}
+
+macro_rules! elementwise {
+    ($trait:ident, $method:ident, $assign:ident, $assign_method:ident, $op:tt) => {
+        impl $trait for SampledSpectrum {
+            type Output = SampledSpectrum;
+            #[inline]
+            fn $method(self, o: SampledSpectrum) -> SampledSpectrum {
+                self.zip(o, |a, b| a $op b)
+            }
+        }
+        impl $trait<f64> for SampledSpectrum {
+            type Output = SampledSpectrum;
+            #[inline]
+            fn $method(self, s: f64) -> SampledSpectrum {
+                self.map(|a| a $op s)
+            }
+        }
+        impl $assign for SampledSpectrum {
+            #[inline]
+            fn $assign_method(&mut self, o: SampledSpectrum) {
+                *self = *self $op o;
+            }
+        }
+        impl $assign<f64> for SampledSpectrum {
+            #[inline]
+            fn $assign_method(&mut self, s: f64) {
+                *self = *self $op s;
+            }
+        }
+    };
+}
+
+elementwise!(Add, add, AddAssign, add_assign, +);
+elementwise!(Mul, mul, MulAssign, mul_assign, *);
+elementwise!(Div, div, DivAssign, div_assign, /);
+
+impl Sub for SampledSpectrum {
+    type Output = SampledSpectrum;
+    #[inline]
+    fn sub(self, o: SampledSpectrum) -> SampledSpectrum {
+        self.zip(o, |a, b| a - b)
+    }
+}
+
+impl Mul<SampledSpectrum> for f64 {
+    type Output = SampledSpectrum;
+    #[inline]
+    fn mul(self, s: SampledSpectrum) -> SampledSpectrum {
+        s * self
+    }
+}
+
+impl Neg for SampledSpectrum {
+    type Output = SampledSpectrum;
+    fn neg(self) -> SampledSpectrum {
+        self.map(|v| -v)
+    }
+}
+
+impl Index<usize> for SampledSpectrum {
+    type Output = f64;
+    fn index(&self, i: usize) -> &f64 {
+        &self.0[i]
+    }
+}
+
+impl IndexMut<usize> for SampledSpectrum {
+    fn index_mut(&mut self, i: usize) -> &mut f64 {
+        &mut self.0[i]
+    }
+}
+
+/// How light is represented while rendering.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ColorMode {
+    /// Wavelengths sampled per camera sample; the film integrates against the CIE observer.
+    #[default]
+    Spectral,
+    /// Three channels, linear sRGB primaries, as RGB renderers work.
+    Rgb,
+}
+
+/// The wavelengths (nm) a sample carries and their sampling densities (per nm), or the
+/// three RGB channels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampledWavelengths {
+    lambda: [f64; N_SAMPLES],
+    pdf: [f64; N_SAMPLES],
+    mode: ColorMode,
+}
+
+impl SampledWavelengths {
+    /// RGB mode: the lanes are channels. `lambda` reports a representative wavelength per
+    /// channel for anything that must pick one (all at the sodium D line, 589.3 nm, so a
+    /// dispersive medium in RGB mode takes its usual tabulated index).
+    pub fn rgb() -> Self {
+        SampledWavelengths {
+            lambda: [589.3; N_SAMPLES],
+            pdf: [1.0, 1.0, 1.0, 0.0],
+            mode: ColorMode::Rgb,
+        }
+    }
+
+    /// Wavelengths and pdfs as given (tests and tools).
+    pub fn from_parts(lambda: [f64; N_SAMPLES], pdf: [f64; N_SAMPLES]) -> Self {
+        SampledWavelengths {
+            lambda,
+            pdf,
+            mode: ColorMode::Spectral,
+        }
+    }
+
+    /// Uniform over [min, max]: the hero at u, the others equally spaced, wrapping around.
+    pub fn sample_uniform(u: f64, min: f64, max: f64) -> Self {
+        let delta = (max - min) / N_SAMPLES as f64;
+        let mut lambda = [0.0; N_SAMPLES];
+        lambda[0] = min + u * (max - min);
+        for i in 1..N_SAMPLES {
+            lambda[i] = lambda[i - 1] + delta;
+            if lambda[i] > max {
+                lambda[i] = min + (lambda[i] - max);
+            }
+        }
+        Self::from_parts(lambda, [1.0 / (max - min); N_SAMPLES])
+    }
+
+    pub fn mode(&self) -> ColorMode {
+        self.mode
+    }
+
+    pub fn is_rgb(&self) -> bool {
+        self.mode == ColorMode::Rgb
+    }
+
+    pub fn lambda(&self) -> &[f64; N_SAMPLES] {
+        &self.lambda
+    }
+
+    pub fn pdf(&self) -> SampledSpectrum {
+        SampledSpectrum(self.pdf)
+    }
+
+    /// After a wavelength-dependent event (dispersive refraction) only the hero wavelength
+    /// goes on: the others get pdf 0 and the hero's pdf is divided by N, since the path could
+    /// have been started by any of the N (pbrt-v4's `TerminateSecondary`). Nothing happens in
+    /// RGB mode or when already terminated.
+    pub fn terminate_secondary(&mut self) {
+        if self.is_rgb() || self.secondary_terminated() {
+            return;
+        }
+        for i in 1..N_SAMPLES {
+            self.pdf[i] = 0.0;
+        }
+        self.pdf[0] /= N_SAMPLES as f64;
+    }
+
+    pub fn secondary_terminated(&self) -> bool {
+        !self.is_rgb() && self.pdf[1..].iter().all(|&p| p == 0.0)
+    }
+}
