@@ -10,7 +10,7 @@ mod trace;
 
 use clap::{Args, Parser, Subcommand};
 use plenum_core::accel::AccelKind;
-use plenum_core::integrator::{WhittedConfig, MAX_DEPTH};
+use plenum_core::integrator::{ColorMode, IntegratorConfig, IntegratorKind, MAX_DEPTH};
 use plenum_core::render::{render, Adaptive, RenderSettings, MAX_SUBDIVISION};
 use plenum_core::sampling::{Filter, FilterKind, PixelSampler, SamplerKind, MAX_SPP};
 use plenum_scene::{builtin_scene, load_scene, LoadedScene};
@@ -93,9 +93,22 @@ struct ViewArgs {
     /// Adaptive sampling by variance: samples per pixel before the first check, and per batch.
     #[arg(long, default_value_t = 16)]
     min_spp: u32,
-    /// Maximum number of reflection/refraction bounces.
+    /// Maximum number of reflection/refraction bounces after the camera ray (0: direct light
+    /// only).
     #[arg(long)]
     max_depth: Option<u32>,
+    /// The rendering method: whitted (recursive ray tracing with the Phong model) or path
+    /// (path tracing). Default: the scene file's choice, else path for a scene of physically
+    /// based materials only and whitted otherwise.
+    #[arg(long)]
+    integrator: Option<IntegratorArg>,
+    /// How light is represented: spectral (4 sampled wavelengths per camera sample; the
+    /// default) or rgb (three channels, as RGB renderers work).
+    #[arg(long)]
+    color: Option<ColorArg>,
+    /// Path tracing: Russian roulette from this many bounces on (default 5).
+    #[arg(long)]
+    rr_depth: Option<u32>,
     /// Random seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -141,6 +154,35 @@ struct TracePixelArgs {
     json: bool,
     #[command(flatten)]
     view: ViewArgs,
+}
+
+/// `--integrator`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct IntegratorArg(IntegratorKind);
+
+impl std::str::FromStr for IntegratorArg {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        IntegratorKind::from_name(s).map(IntegratorArg).ok_or_else(|| {
+            let names: Vec<&str> = IntegratorKind::ALL.iter().map(|k| k.name()).collect();
+            format!("unknown integrator `{s}`: expected one of {}", names.join(", "))
+        })
+    }
+}
+
+/// `--color`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ColorArg(ColorMode);
+
+impl std::str::FromStr for ColorArg {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "spectral" => Ok(ColorArg(ColorMode::Spectral)),
+            "rgb" => Ok(ColorArg(ColorMode::Rgb)),
+            _ => Err(format!("unknown colour mode `{s}`: expected spectral or rgb")),
+        }
+    }
 }
 
 /// `--sampler`: a fixed-count pattern, or adaptive sampling.
@@ -315,15 +357,31 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
             })
         }
     };
+    let method = view
+        .integrator
+        .map(|a| a.0)
+        .or(d.integrator)
+        .unwrap_or_else(|| loaded.scene.default_integrator());
+    let color = view.color.map(|a| a.0).or(d.color).unwrap_or_default();
+    let light_sampler = d.light_sampler;
+    loaded.scene.set_light_sampler(light_sampler);
+    if method != IntegratorKind::Whitted && color == ColorMode::Rgb {
+        if let Some(what) = loaded.scene.needs_wavelengths() {
+            eprintln!("warning: {what} needs wavelengths: in RGB mode it is rendered at 589.3 nm (use --color spectral)");
+        }
+    }
     Ok(RenderSettings {
         width,
         height,
         sampler,
         filter,
         adaptive,
-        integrator: WhittedConfig {
+        integrator: IntegratorConfig {
+            kind: method,
             max_depth,
             min_weight: d.min_weight,
+            rr_depth: view.rr_depth.unwrap_or(d.rr_depth),
+            color,
         },
         seed: view.seed,
         corners: view.nff_corners,
@@ -440,6 +498,12 @@ fn run_render(args: RenderArgs) -> ExitCode {
             c.refraction,
             c.total() as f64 / elapsed / 1e6,
             args.output.display()
+        );
+    }
+    if output.counts.invalid > 0 {
+        eprintln!(
+            "warning: {} samples came out NaN or infinite and were left out of the image",
+            output.counts.invalid
         );
     }
     if !output.complete {

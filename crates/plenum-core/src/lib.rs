@@ -4,12 +4,14 @@
 //! arrive already built (see `plenum-scene`); images leave as a [`film::Film`] of linear RGB.
 
 pub mod accel;
+pub mod bxdf;
 pub mod camera;
 pub mod color;
 pub mod film;
 pub mod geometry;
 pub mod integrator;
 pub mod light;
+pub mod light_sampler;
 pub mod material;
 pub mod math;
 pub mod optics;

@@ -9,7 +9,8 @@
 //! gives, ∫ L_e cos θ dω, which falls off with the square of the distance.
 
 use crate::color::Color;
-use crate::math::Vec3;
+use crate::geometry::Shape;
+use crate::math::{Transform, Vec3};
 use crate::sampling::{
     concentric_disk, uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_triangle, Frame,
 };
@@ -64,13 +65,18 @@ pub enum Light {
         intensity: Color,
         attenuation: Attenuation,
     },
-    /// A surface that emits radiance `radiance` from every point, toward both sides.
+    /// A surface that emits radiance `radiance` from every point, toward both sides or, when
+    /// not `two_sided`, only toward the side its normal points to.
     Area {
         shape: Emitter,
         radiance: Color,
         /// Shadow rays per shading point, stratified over the area (rounded up to a square).
         samples: u32,
+        two_sided: bool,
     },
+    /// Radiance `radiance` arriving from every direction at infinity (physically based
+    /// integrators only; Whitted's scenes have their `background`).
+    Infinite { radiance: Color },
 }
 
 /// The surface of an area light, in world coordinates.
@@ -100,6 +106,61 @@ pub enum Emitter {
 }
 
 impl Emitter {
+    /// The emitter that samples a placed shape's surface: a sphere (under a transform that
+    /// keeps it round) or disk as itself, a mesh, polygon, box or polyhedron by its
+    /// triangles in world space (normals by their winding); `None` for shapes it cannot
+    /// sample (planes, cylinders, cones) or without area.
+    pub fn of_shape(shape: &Shape, to_world: &Transform) -> Option<Emitter> {
+        let world = |p: Vec3| to_world.point(p);
+        let fan = |vs: &[Vec3]| -> Vec<[Vec3; 3]> {
+            (1..vs.len().saturating_sub(1))
+                .map(|i| [world(vs[0]), world(vs[i]), world(vs[i + 1])])
+                .collect()
+        };
+        match shape {
+            Shape::Sphere(s) => {
+                let center = world(s.center);
+                let axes = [Vec3::X, Vec3::Y, Vec3::Z].map(|a| to_world.vector(a).length());
+                let round = axes.iter().all(|&l| (l - axes[0]).abs() <= 1e-9 * axes[0]);
+                round.then(|| Emitter::Sphere {
+                    center,
+                    radius: s.radius * axes[0],
+                })
+            }
+            Shape::Disk(d) if to_world.is_identity() => Some(Emitter::Disk {
+                center: d.center,
+                normal: d.normal.normalized(),
+                radius: d.radius,
+            }),
+            Shape::Mesh(m) => Emitter::triangles(m.triangles().map(|(_, t)| t.map(world)).collect()),
+            Shape::Polygon(p) => Emitter::triangles(fan(p.vertices())),
+            Shape::Polyhedron(p) => {
+                Emitter::triangles(p.faces().iter().flat_map(|f| fan(f.vertices())).collect())
+            }
+            Shape::Cuboid(c) => {
+                let (a, b) = (c.min, c.max);
+                let v = |x: bool, y: bool, z: bool| {
+                    Vec3::new(
+                        if x { b.x } else { a.x },
+                        if y { b.y } else { a.y },
+                        if z { b.z } else { a.z },
+                    )
+                };
+                // Six faces, each wound so that its normal points out of the box.
+                let faces = [
+                    [v(false, false, false), v(false, true, false), v(true, true, false), v(true, false, false)],
+                    [v(false, false, true), v(true, false, true), v(true, true, true), v(false, true, true)],
+                    [v(false, false, false), v(true, false, false), v(true, false, true), v(false, false, true)],
+                    [v(false, true, false), v(false, true, true), v(true, true, true), v(true, true, false)],
+                    [v(false, false, false), v(false, false, true), v(false, true, true), v(false, true, false)],
+                    [v(true, false, false), v(true, true, false), v(true, true, true), v(true, false, true)],
+                ];
+                Emitter::triangles(faces.iter().flat_map(|f| fan(f)).collect())
+            }
+            _ => None,
+        }
+    }
+
     /// An emitter made of world-space triangles; `None` when they have no area.
     pub fn triangles(triangles: Vec<[Vec3; 3]>) -> Option<Emitter> {
         let mut sum = 0.0;
@@ -127,10 +188,31 @@ impl Emitter {
         }
     }
 
-    /// A point of the surface for `p` to aim at, and the pdf of choosing it with respect to
-    /// solid angle at `p` (the area pdf converted by d² / |cos θ_light|); `None` if the
-    /// sample sees the surface edge-on.
-    fn sample(&self, p: Vec3, u: [f64; 2]) -> Option<(Vec3, f64)> {
+    /// The solid-angle pdf at `p` with which [`Emitter::sample`] picks the surface point `q`
+    /// whose unit normal is `n`: the sphere's cone pdf seen from outside, otherwise the
+    /// uniform area pdf converted by d² / |cos θ_light|.
+    pub fn pdf(&self, p: Vec3, q: Vec3, n: Vec3) -> f64 {
+        if let Emitter::Sphere { center, radius } = self {
+            let d2 = (*center - p).length_squared();
+            let r2 = radius * radius;
+            if d2 > r2 * (1.0 + 1e-9) {
+                let cos_max = ((d2 - r2).max(0.0)).sqrt() / d2.sqrt();
+                return uniform_cone_pdf(cos_max);
+            }
+        }
+        let to = q - p;
+        let d2 = to.length_squared();
+        let cos_light = n.dot(to).abs() / d2.sqrt();
+        if cos_light <= 0.0 || d2 == 0.0 {
+            return 0.0;
+        }
+        d2 / (cos_light * self.area())
+    }
+
+    /// A point of the surface for `p` to aim at, its unit normal, and the pdf of choosing it
+    /// with respect to solid angle at `p` (the area pdf converted by d² / |cos θ_light|);
+    /// `None` if the sample sees the surface edge-on.
+    fn sample_with_normal(&self, p: Vec3, u: [f64; 2]) -> Option<(Vec3, Vec3, f64)> {
         let (point, normal) = match self {
             Emitter::Sphere { center, radius } => {
                 let to_center = *center - p;
@@ -147,7 +229,9 @@ impl Emitter {
                     let b = w.dot(to_center);
                     let disc = (r2 - (d2 - b * b)).max(0.0);
                     let s = b - disc.sqrt();
-                    return Some((p + w * s, uniform_cone_pdf(cos_max)));
+                    let q = p + w * s;
+                    let n = (q - *center) / *radius;
+                    return Some((q, n, uniform_cone_pdf(cos_max)));
                 }
                 let n = uniform_sphere(u);
                 (*center + n * *radius, n)
@@ -194,8 +278,33 @@ impl Emitter {
         if cos_light <= 0.0 || d2 == 0.0 {
             return None;
         }
-        Some((point, d2 / (cos_light * self.area())))
+        Some((point, normal, d2 / (cos_light * self.area())))
     }
+
+    fn sample(&self, p: Vec3, u: [f64; 2]) -> Option<(Vec3, f64)> {
+        self.sample_with_normal(p, u).map(|(q, _, pdf)| (q, pdf))
+    }
+}
+
+/// A light sample for the physically based integrators, which weigh it by multiple
+/// importance sampling: the light's spectrum is applied by the caller, `scale` holds the
+/// geometric factors, and the pdf comes separately.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction from the shaded point toward the light.
+    pub wi: Vec3,
+    pub distance: f64,
+    /// The light's point, for aiming shadow rays; None at infinity.
+    pub position: Option<Vec3>,
+    /// What multiplies the light's radiance (or intensity): 1/d² and a spot's falloff for
+    /// point lights, 0 for an area light seen from its dark side, 1 otherwise.
+    pub scale: f64,
+    /// Solid-angle pdf of the direction; 1 for delta lights.
+    pub pdf: f64,
+    /// The light is a point or a direction: no other strategy can find it.
+    pub delta: bool,
+    /// Where the shadow ray stops, as a fraction of the way to `position`.
+    pub shadow_end: f64,
 }
 
 /// Light arriving at a point.
@@ -238,10 +347,150 @@ impl Light {
         }
     }
 
+    /// A light sample for the physically based integrators, at point `p` with `u` ∈ [0, 1)².
+    /// Point and spot lights follow the inverse-square law here (Whitted's attenuation is
+    /// not applied: it is the Phong model's).
+    pub fn sample_li(&self, p: Vec3, u: [f64; 2]) -> Option<LightSample> {
+        match *self {
+            Light::Area {
+                ref shape,
+                two_sided,
+                ..
+            } => {
+                let (q, n, pdf) = shape.sample_with_normal(p, u)?;
+                let to = q - p;
+                let d = to.length();
+                if !(pdf > 0.0 && pdf.is_finite() && d > 0.0) {
+                    return None;
+                }
+                let wi = to / d;
+                let lit = two_sided || n.dot(-wi) > 0.0;
+                Some(LightSample {
+                    wi,
+                    distance: d,
+                    position: Some(q),
+                    scale: if lit { 1.0 } else { 0.0 },
+                    pdf,
+                    delta: false,
+                    shadow_end: AREA_SHADOW_END,
+                })
+            }
+            Light::Infinite { .. } => {
+                let wi = uniform_sphere(u);
+                Some(LightSample {
+                    wi,
+                    distance: f64::INFINITY,
+                    position: None,
+                    scale: 1.0,
+                    pdf: 1.0 / (4.0 * std::f64::consts::PI),
+                    delta: false,
+                    shadow_end: f64::INFINITY,
+                })
+            }
+            Light::Point { position, .. } | Light::Spot { position, .. } => {
+                let inc = self.incident(p, u)?;
+                let falloff = match *self {
+                    Light::Spot {
+                        direction,
+                        cos_inner,
+                        cos_outer,
+                        ..
+                    } => smoothstep(cos_outer, cos_inner, (-inc.wi).dot(direction)),
+                    _ => 1.0,
+                };
+                let d2 = (position - p).length_squared();
+                Some(LightSample {
+                    wi: inc.wi,
+                    distance: inc.distance,
+                    position: inc.position,
+                    scale: falloff / d2,
+                    pdf: 1.0,
+                    delta: true,
+                    shadow_end: inc.shadow_end,
+                })
+            }
+            Light::Directional { direction, .. } => Some(LightSample {
+                wi: -direction,
+                distance: f64::INFINITY,
+                position: None,
+                scale: 1.0,
+                pdf: 1.0,
+                delta: true,
+                shadow_end: f64::INFINITY,
+            }),
+        }
+    }
+
+    /// The solid-angle pdf at `p` of [`Light::sample_li`] choosing the point `q` (unit normal
+    /// `n`) of an area light, or the direction `wi` of an infinite light; 0 for delta lights.
+    pub fn pdf_li(&self, p: Vec3, q: Vec3, n: Vec3) -> f64 {
+        match self {
+            Light::Area { shape, .. } => shape.pdf(p, q, n),
+            Light::Infinite { .. } => 1.0 / (4.0 * std::f64::consts::PI),
+            _ => 0.0,
+        }
+    }
+
+    /// Whether an area light's surface, with unit normal `n`, emits toward `w`.
+    pub fn emits_toward(&self, n: Vec3, w: Vec3) -> bool {
+        match self {
+            Light::Area { two_sided, .. } => *two_sided || n.dot(w) > 0.0,
+            _ => true,
+        }
+    }
+
+    /// The light's power by the luminance of its RGB value, in a scene of bounding radius
+    /// `radius` (for lights at infinity): what the power light sampler picks lights by.
+    pub fn power(&self, radius: f64) -> f64 {
+        use std::f64::consts::PI;
+        match self {
+            Light::Point { intensity, .. } => 4.0 * PI * intensity.luminance(),
+            Light::Spot {
+                intensity,
+                cos_inner,
+                cos_outer,
+                ..
+            } => 2.0 * PI * intensity.luminance() * (1.0 - 0.5 * (cos_inner + cos_outer)),
+            Light::Area {
+                shape,
+                radiance,
+                two_sided,
+                ..
+            } => {
+                let sides = if *two_sided { 2.0 } else { 1.0 };
+                PI * sides * shape.area() * radiance.luminance()
+            }
+            Light::Directional { intensity, .. } => PI * radius * radius * intensity.luminance(),
+            Light::Infinite { radiance } => 4.0 * PI * PI * radius * radius * radiance.luminance(),
+        }
+    }
+
+    /// Replaces the light's RGB value (by that of the spectrum it was given as).
+    pub fn set_rgb(&mut self, c: Color) {
+        match self {
+            Light::Point { intensity, .. }
+            | Light::Spot { intensity, .. }
+            | Light::Directional { intensity, .. } => *intensity = c,
+            Light::Area { radiance, .. } | Light::Infinite { radiance } => *radiance = c,
+        }
+    }
+
+    /// The light's RGB value: intensity, radiance or irradiance, as it was given.
+    pub fn rgb(&self) -> Color {
+        match *self {
+            Light::Point { intensity, .. }
+            | Light::Spot { intensity, .. }
+            | Light::Directional { intensity, .. } => intensity,
+            Light::Area { radiance, .. } | Light::Infinite { radiance } => radiance,
+        }
+    }
+
     /// What the light sends to point `p` along its sample `u` ∈ [0, 1)² (ignored by lights
     /// that are points), before any shadowing; `None` when nothing arrives.
     pub fn incident(&self, p: Vec3, u: [f64; 2]) -> Option<Incident> {
         match *self {
+            // Not a light of Whitted's model: the path tracer's only.
+            Light::Infinite { .. } => None,
             Light::Area {
                 ref shape,
                 radiance,
@@ -385,6 +634,7 @@ mod tests {
                 shape,
                 radiance: Color::WHITE,
                 samples: 1,
+                two_sided: true,
             };
             SphericalBins::about_z(0.3, [30, 60])
                 .test(

@@ -13,7 +13,7 @@
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::Film;
-use crate::integrator::{RayCounts, RayTree, Whitted, WhittedConfig};
+use crate::integrator::{Integrator, IntegratorConfig, RayCounts, RayTree};
 use crate::sampling::{Filter, PixelSampler, Rng, SampleStream};
 use crate::scene::Scene;
 use rayon::prelude::*;
@@ -29,7 +29,8 @@ pub struct RenderSettings {
     pub filter: Filter,
     /// Spend samples where the image needs them; replaces the sampler's fixed count.
     pub adaptive: Option<Adaptive>,
-    pub integrator: WhittedConfig,
+    /// Which integrator, and its settings.
+    pub integrator: IntegratorConfig,
     pub seed: u64,
     /// The SPD test procedure (Haines 1987): one ray through every pixel corner, (W+1)×(H+1)
     /// rays in all, each pixel the average of its four corners. Replaces the sampler.
@@ -44,7 +45,7 @@ impl Default for RenderSettings {
             sampler: PixelSampler::Grid { n: 1 },
             filter: Filter::default(),
             adaptive: None,
-            integrator: WhittedConfig::default(),
+            integrator: IntegratorConfig::default(),
             seed: 0,
             corners: false,
         }
@@ -94,7 +95,7 @@ pub fn render(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> RenderOutput {
     let camera = Camera::new(&scene.camera, settings.width, settings.height);
-    let whitted = Whitted::new(scene, settings.integrator);
+    let integrator = Integrator::new(scene, &settings.integrator);
     // In corner mode the grid rendered is that of the corners, one ray each.
     let extra = u32::from(settings.corners);
     let (w, h) = (settings.width + extra, settings.height + extra);
@@ -121,7 +122,7 @@ pub fn render(
             let (first, done) = tiles.run(0, &mut counts, |x, y, c| {
                 let mut e = PixelEstimate::default();
                 sample_pixel(
-                    &whitted,
+                    &integrator,
                     &camera,
                     settings,
                     (x, y),
@@ -141,7 +142,7 @@ pub fn render(
             let (refined, rest) = tiles.run(1, &mut counts, |x, y, c| {
                 let mut e = first[(y * w + x) as usize].clone();
                 if done && near_open(x, y) {
-                    refine_pixel(&whitted, &camera, settings, (x, y), &mut e, c, None);
+                    refine_pixel(&integrator, &camera, settings, (x, y), &mut e, c, None);
                 }
                 Some(e.value())
             });
@@ -157,9 +158,9 @@ pub fn render(
             if settings.corners {
                 let mut stream = corner_stream(settings.seed, x, y);
                 let ray = camera.ray(x as f64, y as f64);
-                whitted.camera_ray(&ray, &mut stream, c, None)
+                integrator.camera_ray(&ray, &mut stream, c, None)
             } else {
-                render_pixel(&whitted, &camera, settings, x, y, c, None)
+                render_pixel(&integrator, &camera, settings, x, y, c, None)
             }
         }),
     };
@@ -261,7 +262,7 @@ fn average_corners(corners: &Film) -> Film {
 
 /// The average radiance of one pixel's samples (a box filter).
 fn render_pixel(
-    whitted: &Whitted,
+    integrator: &Integrator,
     camera: &Camera,
     settings: &RenderSettings,
     x: u32,
@@ -274,13 +275,13 @@ fn render_pixel(
         for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
             let mut stream = corner_stream(settings.seed, x + dx, y + dy);
             let ray = camera.ray((x + dx) as f64, (y + dy) as f64);
-            sum += whitted.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut());
+            sum += integrator.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut());
         }
         return sum * 0.25;
     }
     match settings.adaptive {
         Some(Adaptive::Subdivide { contrast, depth }) => subdivide_pixel(
-            whitted,
+            integrator,
             camera,
             settings,
             (x, y),
@@ -293,7 +294,7 @@ fn render_pixel(
             let mut e = PixelEstimate::default();
             let first = 0..min_spp;
             sample_pixel(
-                whitted,
+                integrator,
                 camera,
                 settings,
                 (x, y),
@@ -302,13 +303,13 @@ fn render_pixel(
                 counts,
                 tree.as_deref_mut(),
             );
-            refine_pixel(whitted, camera, settings, (x, y), &mut e, counts, tree);
+            refine_pixel(integrator, camera, settings, (x, y), &mut e, counts, tree);
             e.value()
         }
         None => {
             let mut e = PixelEstimate::default();
             let all = 0..settings.sampler.samples_per_pixel();
-            sample_pixel(whitted, camera, settings, (x, y), all, &mut e, counts, tree);
+            sample_pixel(integrator, camera, settings, (x, y), all, &mut e, counts, tree);
             e.value()
         }
     }
@@ -318,7 +319,7 @@ fn render_pixel(
 /// Sobol sequence, otherwise from the settings' sampler.
 #[allow(clippy::too_many_arguments)]
 fn sample_pixel(
-    whitted: &Whitted,
+    integrator: &Integrator,
     camera: &Camera,
     settings: &RenderSettings,
     (x, y): (u32, u32),
@@ -338,7 +339,7 @@ fn sample_pixel(
         let shutter = stream.next_1d();
         let (px, py) = (x as f64 + 0.5 + f.dx, y as f64 + 0.5 + f.dy);
         let ray = camera.sample_ray(px, py, lens, shutter);
-        let c = whitted.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut());
+        let c = integrator.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut());
         estimate.add(c, f.weight);
     }
 }
@@ -346,7 +347,7 @@ fn sample_pixel(
 /// Adaptive variance mode: at least one more batch of samples, then more batches until the
 /// pixel's error estimate is below the threshold or its budget is spent.
 fn refine_pixel(
-    whitted: &Whitted,
+    integrator: &Integrator,
     camera: &Camera,
     settings: &RenderSettings,
     pixel: (u32, u32),
@@ -370,7 +371,7 @@ fn refine_pixel(
             return;
         }
         let (c, t) = (&mut *counts, tree.as_deref_mut());
-        sample_pixel(whitted, camera, settings, pixel, start..end, estimate, c, t);
+        sample_pixel(integrator, camera, settings, pixel, start..end, estimate, c, t);
         if estimate.converged(threshold) {
             return;
         }
@@ -424,7 +425,7 @@ impl PixelEstimate {
 /// Whitted's adaptive subdivision of pixel (x, y); see [`Adaptive::Subdivide`].
 #[allow(clippy::too_many_arguments)]
 fn subdivide_pixel(
-    whitted: &Whitted,
+    integrator: &Integrator,
     camera: &Camera,
     settings: &RenderSettings,
     (x, y): (u32, u32),
@@ -449,7 +450,7 @@ fn subdivide_pixel(
                 stream.next_2d(),
                 stream.next_1d(),
             );
-            whitted.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut())
+            integrator.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut())
         })
     };
     // Squares still to look at: lattice corner (i, j), side in lattice steps, level.
@@ -495,11 +496,11 @@ fn corner_stream(seed: u64, x: u32, y: u32) -> SampleStream {
 /// The ray tree of one pixel: every ray of every sample, and the pixel's colour.
 pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> (RayTree, Color) {
     let camera = Camera::new(&scene.camera, settings.width, settings.height);
-    let whitted = Whitted::new(scene, settings.integrator);
+    let integrator = Integrator::new(scene, &settings.integrator);
     let mut tree = RayTree::default();
     let mut counts = RayCounts::default();
     let c = render_pixel(
-        &whitted,
+        &integrator,
         &camera,
         settings,
         x,

@@ -6,7 +6,11 @@ use crate::camera::CameraSettings;
 use crate::color::Color;
 use crate::geometry::{Disk, HitRecord, Polygon, Shape, Sphere, TriangleMesh};
 use crate::light::{Emitter, Light};
-use crate::material::{Coefficients, Material};
+use crate::bxdf::Bsdf;
+use crate::light_sampler::{LightSampler, LightSamplerKind};
+use crate::material::{Coefficients, Material, Scattering, SpectrumKind, SpectrumValue};
+use crate::sampling::Rng;
+use plenum_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 use crate::math::{gamma, Bounds3, Motion, Ray, Transform, Vec3};
 use crate::texture::TextureCoords;
 use std::sync::Arc;
@@ -172,6 +176,16 @@ pub struct Scene {
     pub ambient: Color,
     /// Radiance of rays that hit nothing.
     pub background: Color,
+    /// The background as a spectrum, for the physically based integrators.
+    background_spectrum: SpectrumValue,
+    /// Per light: its emission as a spectrum (an RGB light's uplifted as an illuminant).
+    light_spectra: Vec<SpectrumValue>,
+    /// Per primitive: the area light it is the surface of.
+    primitive_lights: Vec<Option<u32>>,
+    /// The lights at infinity, which rays that hit nothing see.
+    pub infinite_lights: Vec<u32>,
+    /// Chooses a light for next-event estimation.
+    pub light_sampler: LightSampler,
     accel: Accel,
     /// Primitive index of each item of `accel`, which holds the bounded primitives only.
     bounded: Vec<u32>,
@@ -323,11 +337,126 @@ impl Scene {
             let weights = [1.0 - b1 - b2, b1, b2];
             let parts = [0, 1, 2].map(|i| {
                 let m = &self.materials[ids[triangle[i] as usize] as usize];
-                (weights[i], m.evaluate(&it.texture))
+                (weights[i], m.coefficients(&it.texture))
             });
             return Coefficients::blend(&parts);
         }
-        self.material_of(it.primitive).evaluate(&it.texture)
+        self.material_of(it.primitive).coefficients(&it.texture)
+    }
+
+    /// The area light whose surface the primitive is.
+    #[inline]
+    pub fn light_of(&self, primitive: u32) -> Option<u32> {
+        self.primitive_lights[primitive as usize]
+    }
+
+    /// Light `light`'s radiance (or intensity) at the sample's wavelengths.
+    #[inline]
+    pub fn light_spectrum(&self, light: u32, wl: &SampledWavelengths) -> SampledSpectrum {
+        self.light_spectra[light as usize].sample(wl)
+    }
+
+    /// The background's radiance at the sample's wavelengths.
+    #[inline]
+    pub fn background_spectrum(&self, wl: &SampledWavelengths) -> SampledSpectrum {
+        if self.background.is_black() {
+            SampledSpectrum::ZERO
+        } else {
+            self.background_spectrum.sample(wl)
+        }
+    }
+
+    /// `path` for a scene whose objects are all of physically based materials (emitters that
+    /// only show their light aside), `whitted` otherwise.
+    pub fn default_integrator(&self) -> crate::integrator::IntegratorKind {
+        use crate::integrator::IntegratorKind;
+        let physical = self.primitives.iter().all(|p| {
+            p.vertex_materials.is_none() && {
+                let m = &self.materials[p.material as usize];
+                m.is_physical() || m.is_emitter_only()
+            }
+        });
+        if physical && !self.primitives.is_empty() {
+            IntegratorKind::Path
+        } else {
+            IntegratorKind::Whitted
+        }
+    }
+
+    /// What in the scene varies with wavelength beyond what RGB can carry (a dispersive
+    /// index, a measured spectrum), named for a warning; `None` if nothing does.
+    pub fn needs_wavelengths(&self) -> Option<String> {
+        for (m, name) in self.materials.iter().zip(&self.material_names) {
+            if let Some(what) = m.wavelength_dependence() {
+                return Some(format!("material `{name}` ({what})"));
+            }
+        }
+        None
+    }
+
+    /// Chooses how next-event estimation picks lights.
+    pub fn set_light_sampler(&mut self, kind: LightSamplerKind) {
+        self.light_sampler = match kind {
+            LightSamplerKind::Uniform => LightSampler::uniform(self.lights.len()),
+            LightSamplerKind::Power => {
+                let radius = self.scene_radius();
+                let powers: Vec<f64> = self.lights.iter().map(|l| l.power(radius)).collect();
+                LightSampler::new(&powers)
+            }
+        };
+    }
+
+    /// The radius of a sphere about everything bounded (1 for an empty scene).
+    pub fn scene_radius(&self) -> f64 {
+        let b = self.bounds();
+        let r = 0.5 * (b.max - b.min).length();
+        if r.is_finite() && r > 0.0 {
+            r
+        } else {
+            1.0
+        }
+    }
+
+    /// The BSDF at a hit seen from `wo`, for the sample's wavelengths; `None` where nothing
+    /// scatters (an emitter's surface). Per-vertex Phong materials are blended first; a mix
+    /// chooses by a hash of the hit and `wo`, so the choice is the same for any thread.
+    pub fn bsdf(&self, it: &Interaction, wo: Vec3, wl: &mut SampledWavelengths) -> Option<Bsdf> {
+        let p = &self.primitives[it.primitive as usize];
+        let solid = p.shape.is_closed();
+        if p.vertex_materials.is_some() {
+            let k = self.coefficients(it);
+            let phong = Material::Phong(crate::material::PhongMaterial::constant(&k));
+            return self.bsdf_of(&phong, it, wl, solid, 0.5);
+        }
+        let mut id = p.material;
+        let mut rng = Rng::new(hash_hit(it.p, wo), 0);
+        // Mixes of mixes, a few deep; a cycle (which the scene reader refuses) ends here.
+        for _ in 0..16 {
+            match self.materials[id as usize].scattering(&it.texture, wl, solid, rng.uniform()) {
+                Scattering::Bxdf(b) => return self.finish_bsdf(b, it),
+                Scattering::Other(next) => id = next,
+            }
+        }
+        None
+    }
+
+    fn bsdf_of(
+        &self,
+        m: &Material,
+        it: &Interaction,
+        wl: &mut SampledWavelengths,
+        solid: bool,
+        u: f64,
+    ) -> Option<Bsdf> {
+        match m.scattering(&it.texture, wl, solid, u) {
+            Scattering::Bxdf(b) => self.finish_bsdf(b, it),
+            Scattering::Other(_) => None,
+        }
+    }
+
+    fn finish_bsdf(&self, b: crate::bxdf::Bxdf, it: &Interaction) -> Option<Bsdf> {
+        let bsdf = Bsdf::new(it.shading_n, None, b);
+        (!bsdf.flags().is_empty()).then_some(bsdf)
     }
 
     /// Bounds of all bounded primitives.
@@ -349,11 +478,83 @@ pub struct SceneBuilder {
     lights: Vec<Light>,
     light_names: Vec<String>,
     light_objects: Vec<Option<u32>>,
+    /// Per light: a spectrum given in place of its RGB value, and a scale.
+    light_spectra: Vec<Option<(Spectrum, f64)>>,
+    light_sampler: LightSamplerKind,
+}
+
+/// A seed from a hit point and direction, for choices that must not depend on the thread.
+fn hash_hit(p: Vec3, w: Vec3) -> u64 {
+    let mut h: u64 = 0x9E37_79B9_7F4A_7C15;
+    for v in [p.x, p.y, p.z, w.x, w.y, w.z] {
+        h = (h ^ v.to_bits()).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        h ^= h >> 31;
+    }
+    h
 }
 
 impl SceneBuilder {
-    pub fn add_material(&mut self, name: impl Into<String>, material: Material) -> MaterialId {
-        self.materials.push(material);
+    /// Gives the last light added a spectrum (an illuminant) in place of its RGB value; its
+    /// RGB value is then that spectrum's, for Whitted's model and RGB mode.
+    pub fn set_last_light_spectrum(&mut self, spectrum: Spectrum, scale: f64) {
+        if let Some(s) = self.light_spectra.last_mut() {
+            *s = Some((spectrum, scale));
+        }
+    }
+
+    /// Makes the last light added, an area light, emit only toward its normal's side.
+    pub fn set_last_light_one_sided(&mut self) {
+        if let Some(Light::Area { two_sided, .. }) = self.lights.last_mut() {
+            *two_sided = false;
+        }
+    }
+
+    /// How next-event estimation chooses lights (by power unless told).
+    pub fn set_light_sampler(&mut self, kind: LightSamplerKind) {
+        self.light_sampler = kind;
+    }
+
+    /// Places a shape that emits `radiance` (one- or two-sided) and scatters by `material`:
+    /// a physically based area light on any shape that can be sampled (a mesh, sphere, disk
+    /// or polygon). Other shapes are placed without emitting, and `false` comes back.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_emissive_object(
+        &mut self,
+        name: impl Into<String>,
+        shape: Shape,
+        to_world: Transform,
+        material: MaterialId,
+        radiance: Color,
+        two_sided: bool,
+        samples: u32,
+    ) -> bool {
+        let name = name.into();
+        let emitter = Emitter::of_shape(&shape, &to_world);
+        self.add_object(name.clone(), shape, to_world, material);
+        let Some(shape) = emitter else {
+            return false;
+        };
+        self.add_light(
+            name,
+            Light::Area {
+                shape,
+                radiance,
+                samples,
+                two_sided,
+            },
+        );
+        if let Some(last) = self.light_objects.last_mut() {
+            *last = Some((self.primitives.len() - 1) as u32);
+        }
+        true
+    }
+
+    pub fn add_material(
+        &mut self,
+        name: impl Into<String>,
+        material: impl Into<Material>,
+    ) -> MaterialId {
+        self.materials.push(material.into());
         self.material_names.push(name.into());
         (self.materials.len() - 1) as MaterialId
     }
@@ -453,6 +654,7 @@ impl SceneBuilder {
                 shape: emitter,
                 radiance,
                 samples,
+                two_sided: true,
             },
         );
         if let Some(last) = self.light_objects.last_mut() {
@@ -484,6 +686,7 @@ impl SceneBuilder {
                     shape,
                     radiance,
                     samples,
+                    two_sided: true,
                 },
             );
             if let Some(last) = self.light_objects.last_mut() {
@@ -496,6 +699,7 @@ impl SceneBuilder {
         self.lights.push(light);
         self.light_names.push(name.into());
         self.light_objects.push(None);
+        self.light_spectra.push(None);
     }
 
     /// Builds the scene with the default acceleration structure, a BVH.
@@ -541,7 +745,37 @@ impl SceneBuilder {
                 None => self.materials[p.material as usize].needs_uv(),
             })
             .collect();
-        let scene = Scene {
+        // A light given as a spectrum shows that spectrum's RGB in Whitted's model.
+        for (light, spectrum) in self.lights.iter_mut().zip(&self.light_spectra) {
+            if let Some((s, scale)) = spectrum {
+                let [r, g, b] = s.to_rgb_illuminant();
+                light.set_rgb(Color::new(r, g, b) * *scale);
+            }
+        }
+        let light_spectra = self
+            .lights
+            .iter()
+            .zip(&self.light_spectra)
+            .map(|(l, s)| match s {
+                Some((s, scale)) => SpectrumValue::new(s.scaled(*scale), SpectrumKind::Illuminant),
+                None => SpectrumValue::from_rgb(l.rgb(), SpectrumKind::Illuminant),
+            })
+            .collect();
+        let mut primitive_lights = vec![None; self.primitives.len()];
+        for (i, o) in self.light_objects.iter().enumerate() {
+            if let Some(p) = o {
+                primitive_lights[*p as usize] = Some(i as u32);
+            }
+        }
+        let infinite_lights = (0..self.lights.len() as u32)
+            .filter(|&i| matches!(self.lights[i as usize], Light::Infinite { .. }))
+            .collect();
+        let mut scene = Scene {
+            background_spectrum: SpectrumValue::from_rgb(self.background, SpectrumKind::Illuminant),
+            light_spectra,
+            primitive_lights,
+            infinite_lights,
+            light_sampler: LightSampler::default(),
             transmissive,
             needs_uv,
             camera: self.camera,
@@ -558,6 +792,7 @@ impl SceneBuilder {
             ambient: self.ambient,
             background: self.background,
         };
+        scene.set_light_sampler(self.light_sampler);
         if kind == AccelKind::Bvh {
             scene
         } else {

@@ -35,6 +35,14 @@ pub struct RenderDefaults {
     pub min_weight: f64,
     /// Stops of exposure applied before clamping to 8 bits.
     pub exposure: f64,
+    /// The integrator the file asks for; `None`: `path` for a scene of physically based
+    /// materials only, `whitted` otherwise.
+    pub integrator: Option<plenum_core::integrator::IntegratorKind>,
+    /// The colour mode the file asks for; `None`: the command line's default.
+    pub color: Option<plenum_core::integrator::ColorMode>,
+    /// Path tracing: Russian roulette from this many bounces on.
+    pub rr_depth: u32,
+    pub light_sampler: plenum_core::light_sampler::LightSamplerKind,
     /// NFF's view angle between the outermost rays, for the SPD corner-ray procedure.
     pub nff_angle: Option<f64>,
 }
@@ -52,6 +60,10 @@ impl Default for RenderDefaults {
             max_depth: 5,
             min_weight: 1.0 / 256.0,
             exposure: 0.0,
+            integrator: None,
+            color: None,
+            rr_depth: 5,
+            light_sampler: Default::default(),
             nff_angle: None,
         }
     }

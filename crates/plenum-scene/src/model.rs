@@ -7,7 +7,7 @@ use plenum_core::camera::CameraSettings;
 use plenum_core::color::Color;
 use plenum_core::geometry::{Shape, TriangleMesh};
 use plenum_core::light::{Attenuation, Light};
-use plenum_core::material::Material;
+use plenum_core::material::PhongMaterial;
 use plenum_core::math::{Transform, Vec3};
 use plenum_core::scene::SceneBuilder;
 use plenum_core::texture::Texture;
@@ -22,14 +22,14 @@ const FOV: f64 = 35.0;
 pub fn load_model(path: &Path, extension: &str) -> Result<LoadedScene, SceneError> {
     let base = path.parent().unwrap_or(Path::new("."));
     let mut warnings = Vec::new();
-    let groups: Vec<(String, Material, TriangleMesh)> = if extension == "ply" {
+    let groups: Vec<(String, PhongMaterial, TriangleMesh)> = if extension == "ply" {
         vec![("model".into(), default_material(), ply::load_ply(path)?)]
     } else {
         let text = std::fs::read_to_string(path)
             .map_err(|e| SceneError::file(path, format!("cannot read the mesh file: {e}")))?;
         let model = obj::parse_obj_model(path, &text, true)?;
         warnings.extend(model.warnings.iter().cloned());
-        let mut materials: HashMap<String, Material> = HashMap::new();
+        let mut materials: HashMap<String, PhongMaterial> = HashMap::new();
         for lib in &model.material_libraries {
             let lib_path = base.join(lib);
             match std::fs::read_to_string(&lib_path) {
@@ -99,12 +99,12 @@ pub fn load_model(path: &Path, extension: &str) -> Result<LoadedScene, SceneErro
     })
 }
 
-fn default_material() -> Material {
-    Material {
+fn default_material() -> PhongMaterial {
+    PhongMaterial {
         diffuse: Texture::Constant(Color::new(0.75, 0.72, 0.68)),
         ambient: Texture::Constant(Color::new(0.75, 0.72, 0.68)),
         specular: Texture::Constant(Color::gray(0.25)),
         shininess: 40.0,
-        ..Material::default()
+        ..PhongMaterial::default()
     }
 }

@@ -5,7 +5,7 @@
 
 use crate::diagnostics::SceneError;
 use plenum_core::color::Color;
-use plenum_core::material::Material;
+use plenum_core::material::PhongMaterial;
 use plenum_core::texture::{ImageTexture, Texture};
 use std::collections::HashMap;
 use std::path::Path;
@@ -17,11 +17,11 @@ pub fn parse_mtl(
     path: &Path,
     text: &str,
     base_dir: &Path,
-) -> Result<(HashMap<String, Material>, Vec<String>), SceneError> {
+) -> Result<(HashMap<String, PhongMaterial>, Vec<String>), SceneError> {
     let mut out = HashMap::new();
     let mut warnings = Vec::new();
-    let mut current: Option<(String, Material, f64)> = None;
-    let finish = |c: Option<(String, Material, f64)>, out: &mut HashMap<String, Material>| {
+    let mut current: Option<(String, PhongMaterial, f64)> = None;
+    let finish = |c: Option<(String, PhongMaterial, f64)>, out: &mut HashMap<String, PhongMaterial>| {
         if let Some((name, mut m, illum)) = c {
             let illum = illum as i32;
             if matches!(illum, 3 | 5 | 7) {
@@ -66,9 +66,9 @@ pub fn parse_mtl(
             let name = rest
                 .first()
                 .ok_or_else(|| at("expected a material name after `newmtl`".into()))?;
-            let m = Material {
+            let m = PhongMaterial {
                 specular: Texture::Constant(Color::BLACK),
-                ..Material::default()
+                ..PhongMaterial::default()
             };
             current = Some((name.to_string(), m, 2.0));
             continue;

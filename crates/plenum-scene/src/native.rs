@@ -8,9 +8,10 @@ use plenum_core::color::Color;
 use plenum_core::geometry::{
     Cone, Cuboid, Cylinder, Disk, Plane, Polygon, Polyhedron, Shape, Sphere, TriangleMesh,
 };
-use plenum_core::integrator::MAX_DEPTH;
+use plenum_core::integrator::{ColorMode, IntegratorKind, MAX_DEPTH};
+use plenum_core::light_sampler::LightSamplerKind;
 use plenum_core::light::{Attenuation, Emitter, Light};
-use plenum_core::material::Material;
+use plenum_core::material::PhongMaterial;
 use plenum_core::math::{Matrix4, Transform, Vec3};
 use plenum_core::sampling::MAX_SPP;
 use plenum_core::scene::{MaterialId, SceneBuilder};
@@ -29,6 +30,8 @@ const TOP_LEVEL: &[&str] = &[
     "lights",
     "objects",
 ];
+mod physical;
+
 const COMMON: [&str; 5] = ["type", "name", "material", "transform", "transform_close"];
 
 /// Parses a native scene. `base_dir` resolves relative paths (meshes, textures).
@@ -130,8 +133,48 @@ impl<'s> Reader<'s> {
                 "max_depth",
                 "min_weight",
                 "exposure",
+                "integrator",
+                "color",
+                "rr_depth",
+                "light_sampler",
             ],
         )?;
+        if let Some(v) = f.get("integrator") {
+            let name = self.src.string(v)?;
+            d.integrator = Some(IntegratorKind::from_name(name).ok_or_else(|| {
+                let names: Vec<&str> = IntegratorKind::ALL.iter().map(|k| k.name()).collect();
+                self.src
+                    .error(v.span(), format!("unknown integrator `{name}`"))
+                    .with_help(format!("expected one of: {}", names.join(", ")))
+            })?);
+        }
+        if let Some(v) = f.get("color") {
+            d.color = Some(match self.src.string(v)? {
+                "spectral" => ColorMode::Spectral,
+                "rgb" => ColorMode::Rgb,
+                other => {
+                    return Err(self
+                        .src
+                        .error(v.span(), format!("unknown colour mode `{other}`"))
+                        .with_help("expected `spectral` or `rgb`"))
+                }
+            });
+        }
+        if let Some(n) = f.count("rr_depth")? {
+            d.rr_depth = n;
+        }
+        if let Some(v) = f.get("light_sampler") {
+            d.light_sampler = match self.src.string(v)? {
+                "power" => LightSamplerKind::Power,
+                "uniform" => LightSamplerKind::Uniform,
+                other => {
+                    return Err(self
+                        .src
+                        .error(v.span(), format!("unknown light sampler `{other}`"))
+                        .with_help("expected `power` or `uniform`"))
+                }
+            };
+        }
         if let Some(v) = f.get("sampler") {
             match self.src.string(v)? {
                 "adaptive" => d.adaptive = true,
@@ -416,7 +459,18 @@ impl<'s> Reader<'s> {
     }
 
     fn material(&mut self, name: &str, v: &Value<'s>) -> Result<()> {
+        if let DeValue::Table(t) = v.get_ref() {
+            if t.get("type").is_some() {
+                let kind = self.kind(v, &format!("material `{name}`"), physical::MATERIAL_TYPES)?;
+                if let Some(m) = self.physical_material(name, &kind, v)? {
+                    let id = self.builder.add_material(name, m);
+                    self.materials.insert(name.to_string(), id);
+                    return Ok(());
+                }
+            }
+        }
         const FIELDS: &[&str] = &[
+            "type",
             "emissive",
             "ambient",
             "diffuse",
@@ -429,13 +483,13 @@ impl<'s> Reader<'s> {
             "gloss",
         ];
         let f = self.src.table(v, &format!("material `{name}`"), FIELDS)?;
-        let d = Material::default();
+        let d = PhongMaterial::default();
         let tex = |key: &str, default: Texture| f.get(key).map_or(Ok(default), |v| self.texture(v));
         let fresnel = f.bool_or("fresnel", d.fresnel)?;
         // With Fresnel weighting, k_r is a tint: white unless given.
         let reflective_default = if fresnel { Color::WHITE } else { Color::BLACK };
         let diffuse = tex("diffuse", d.diffuse.clone())?;
-        let m = Material {
+        let m = PhongMaterial {
             emissive: tex("emissive", d.emissive.clone())?,
             // Ambient light lights a surface in its own colour unless told otherwise.
             ambient: tex("ambient", diffuse.clone())?,
@@ -479,6 +533,7 @@ impl<'s> Reader<'s> {
                 "rectangle",
                 "disk",
                 "sphere",
+                "infinite",
             ],
         )?;
         let what = format!("{kind} light");
@@ -501,6 +556,7 @@ impl<'s> Reader<'s> {
                         "position",
                         "color",
                         "intensity",
+                        "spectrum",
                         "attenuation",
                     ],
                 )?;
@@ -510,18 +566,20 @@ impl<'s> Reader<'s> {
                     attenuation: self.attenuation(&f)?,
                 };
                 self.builder.add_light(name_of(&f)?, light);
+                self.light_spectrum(&f)?;
             }
             "directional" => {
                 let f = self.src.table(
                     v,
                     &what,
-                    &["type", "name", "direction", "color", "intensity"],
+                    &["type", "name", "direction", "color", "intensity", "spectrum"],
                 )?;
                 let light = Light::Directional {
                     direction: f.direction("direction", None)?.normalized(),
                     intensity: intensity(&f)?,
                 };
                 self.builder.add_light(name_of(&f)?, light);
+                self.light_spectrum(&f)?;
             }
             "spot" => {
                 let f = self.src.table(
@@ -536,6 +594,7 @@ impl<'s> Reader<'s> {
                         "outer_angle",
                         "color",
                         "intensity",
+                        "spectrum",
                         "attenuation",
                     ],
                 )?;
@@ -557,6 +616,7 @@ impl<'s> Reader<'s> {
                     attenuation: self.attenuation(&f)?,
                 };
                 self.builder.add_light(name_of(&f)?, light);
+                self.light_spectrum(&f)?;
             }
             "rectangle" | "disk" | "sphere" => {
                 let shape_keys: &[&str] = match kind.as_str() {
@@ -564,7 +624,7 @@ impl<'s> Reader<'s> {
                     "disk" => &["center", "normal", "radius"],
                     _ => &["center", "radius"],
                 };
-                let keys: Vec<&str> = ["type", "name", "color", "intensity", "samples"]
+                let keys: Vec<&str> = ["type", "name", "color", "intensity", "spectrum", "samples", "two_sided"]
                     .into_iter()
                     .chain(shape_keys.iter().copied())
                     .collect();
@@ -599,6 +659,20 @@ impl<'s> Reader<'s> {
                 let radiance = intensity(&f)?;
                 self.builder
                     .add_area_light(name_of(&f)?, emitter, radiance, samples);
+                if !f.bool_or("two_sided", true)? {
+                    self.builder.set_last_light_one_sided();
+                }
+                self.light_spectrum(&f)?;
+            }
+            "infinite" => {
+                let f = self
+                    .src
+                    .table(v, &what, &["type", "name", "color", "intensity", "spectrum"])?;
+                let light = Light::Infinite {
+                    radiance: intensity(&f)?,
+                };
+                self.builder.add_light(name_of(&f)?, light);
+                self.light_spectrum(&f)?;
             }
             _ => {
                 let f = self
@@ -608,6 +682,15 @@ impl<'s> Reader<'s> {
             }
         }
         Ok(())
+    }
+
+    /// An emitter's radiance: an RGB colour, or a spectrum (whose RGB value is then worked
+    /// out by the scene); times `scale`.
+    fn emission(&self, v: &Value<'s>, scale: f64) -> Result<(Color, Option<plenum_spectrum::Spectrum>)> {
+        match v.get_ref() {
+            DeValue::String(_) | DeValue::Table(_) => Ok((Color::BLACK, Some(self.spectrum(v)?))),
+            _ => Ok((self.non_negative(v, self.color(v)?)? * scale, None)),
+        }
     }
 
     /// Shadow rays per shading point for an area light: 1 to 1024, 1 by default (more
@@ -710,11 +793,11 @@ impl<'s> Reader<'s> {
                 "normals",
                 "uvs",
                 "vertex_materials",
-                "emission",
-                "light_samples",
             ],
         };
-        let allowed: Vec<&'static str> = COMMON.iter().chain(fields).copied().collect();
+        const EMISSION: [&str; 4] = ["emission", "emission_scale", "two_sided", "light_samples"];
+        let allowed: Vec<&'static str> =
+            COMMON.iter().chain(fields).chain(&EMISSION).copied().collect();
         let f = self.src.table(v, &kind, &allowed)?;
         let (shape, frame) = self.shape(&kind, &f)?;
         let placement = match f.get("transform") {
@@ -730,22 +813,50 @@ impl<'s> Reader<'s> {
             Some(t) => Some(self.transform(t)?.after(&frame)),
             None => None,
         };
-        if let (Some(e), Shape::Mesh(mesh)) = (f.get("emission"), &shape) {
-            if f.get("material").is_some() || f.get("vertex_materials").is_some() {
+        if let Some(e) = f.get("emission") {
+            if f.get("vertex_materials").is_some() {
                 return Err(self.src.error(
                     e.span(),
-                    "an emitting mesh shows its emission: drop `material` or `vertex_materials`",
+                    "an emitting object has one material: drop `vertex_materials`",
                 ));
             }
             if close.is_some() {
                 return Err(self
                     .src
-                    .error(e.span(), "an emitting mesh cannot move (`transform_close`)"));
+                    .error(e.span(), "an emitting object cannot move (`transform_close`)"));
             }
-            let radiance = self.non_negative(e, self.color(e)?)?;
+            let scale = f.non_negative_or("emission_scale", 1.0)?;
+            let (radiance, spectrum) = self.emission(e, scale)?;
             let samples = self.light_samples(&f, "light_samples")?;
-            self.builder
-                .add_mesh_light(name, mesh.clone(), to_world, radiance, samples);
+            let two_sided = f.bool_or("two_sided", true)?;
+            match (&shape, f.get("material")) {
+                // Whitted's emitting mesh: it shows its emission and reflects nothing.
+                (Shape::Mesh(mesh), None) if two_sided => {
+                    self.builder
+                        .add_mesh_light(name, mesh.clone(), to_world, radiance, samples);
+                }
+                (_, given) => {
+                    let material = match given {
+                        Some(_) => material,
+                        None => self.builder.add_material(
+                            format!("{name} (emitter)"),
+                            plenum_core::material::Material::emitter(radiance),
+                        ),
+                    };
+                    let what = f.required("emission")?.span();
+                    if !self.builder.add_emissive_object(
+                        name, shape, to_world, material, radiance, two_sided, samples,
+                    ) {
+                        return Err(self.src.error(
+                            what,
+                            format!("a {kind} cannot be an area light: use a mesh, sphere, disk, polygon, box or polyhedron"),
+                        ));
+                    }
+                }
+            }
+            if let Some(s) = spectrum {
+                self.builder.set_last_light_spectrum(s, scale);
+            }
             return Ok(());
         }
         match (f.get("vertex_materials"), shape) {
@@ -784,7 +895,7 @@ impl<'s> Reader<'s> {
             if let Some(&id) = self.materials.get("default") {
                 return Ok(id);
             }
-            let id = self.builder.add_material("default", Material::default());
+            let id = self.builder.add_material("default", PhongMaterial::default());
             self.materials.insert("default".into(), id);
             return Ok(id);
         };

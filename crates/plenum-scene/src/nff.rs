@@ -21,7 +21,7 @@ use plenum_core::camera::CameraSettings;
 use plenum_core::color::Color;
 use plenum_core::geometry::{Cone, Polygon, Shape, Sphere, TriangleMesh};
 use plenum_core::light::{Attenuation, Light};
-use plenum_core::material::Material;
+use plenum_core::material::PhongMaterial;
 use plenum_core::math::{Transform, Vec3};
 use plenum_core::scene::{MaterialId, SceneBuilder};
 use plenum_core::texture::Texture;
@@ -76,7 +76,7 @@ pub fn parse(path: &Path, text: &str) -> Result<(SceneBuilder, RenderDefaults), 
             "f" => {
                 let color = p.color()?;
                 let [kd, ks, shine, t, ior] = p.numbers::<5>()?;
-                let m = Material {
+                let m = PhongMaterial {
                     emissive: Texture::Constant(Color::BLACK),
                     ambient: Texture::Constant(color * kd),
                     diffuse: Texture::Constant(color * kd),

@@ -21,7 +21,7 @@ use plenum_core::camera::CameraSettings;
 use plenum_core::color::Color;
 use plenum_core::geometry::{Cone, Cuboid, Cylinder, Polygon, Shape, Sphere, TriangleMesh};
 use plenum_core::light::{Attenuation, Light};
-use plenum_core::material::Material;
+use plenum_core::material::PhongMaterial;
 use plenum_core::math::{Matrix4, Transform, Vec3};
 use plenum_core::scene::SceneBuilder;
 use plenum_core::texture::{ImageTexture, Texture};
@@ -92,9 +92,9 @@ pub fn parse(
     Ok((p.builder, defaults, p.warnings))
 }
 
-fn zero_material() -> Material {
+fn zero_material() -> PhongMaterial {
     let black = || Texture::Constant(Color::BLACK);
-    Material {
+    PhongMaterial {
         emissive: black(),
         ambient: black(),
         diffuse: black(),
@@ -110,7 +110,7 @@ fn zero_material() -> Material {
 
 /// A material block as written, before the dialect's defaults are applied.
 struct MaterialBlock {
-    material: Material,
+    material: PhongMaterial,
     reflective_given: bool,
 }
 
@@ -123,9 +123,9 @@ struct Parser<'s> {
     /// Dialect A, the classic reader.
     classic: bool,
     builder: SceneBuilder,
-    named: HashMap<String, Material>,
+    named: HashMap<String, PhongMaterial>,
     /// The default material (dialect B's top-level `material = …`).
-    current: Material,
+    current: PhongMaterial,
     warnings: Vec<String>,
     objects: usize,
     lights: usize,
@@ -468,7 +468,7 @@ impl<'s> Parser<'s> {
     }
 
     /// `{ … }`, a name, or a string naming a material.
-    fn material_value(&mut self) -> Result<Material, SceneError> {
+    fn material_value(&mut self) -> Result<PhongMaterial, SceneError> {
         let span = self.span();
         match self.peek() {
             Some(Tok::Punct('{')) => self.material_block(),
@@ -488,7 +488,7 @@ impl<'s> Parser<'s> {
     }
 
     /// A material block; registers it when it has a name.
-    fn material_block(&mut self) -> Result<Material, SceneError> {
+    fn material_block(&mut self) -> Result<PhongMaterial, SceneError> {
         const KNOWN: &[&str] = &[
             "emissive",
             "ambient",
@@ -729,7 +729,7 @@ impl<'s> Parser<'s> {
         format!("{kind} {}", self.objects)
     }
 
-    fn add(&mut self, name: &str, shape: Shape, to_world: Transform, material: Material) {
+    fn add(&mut self, name: &str, shape: Shape, to_world: Transform, material: PhongMaterial) {
         let id = self.builder.add_material(name, material);
         self.builder.add_object(name, shape, to_world, id);
     }
@@ -853,7 +853,7 @@ impl<'s> Parser<'s> {
         ];
         self.punct('{')?;
         let (mut points, mut normals, mut faces) = (Vec::new(), Vec::new(), Vec::new());
-        let mut materials: Vec<Material> = Vec::new();
+        let mut materials: Vec<PhongMaterial> = Vec::new();
         let mut material = None;
         let mut gennormals = false;
         while !self.eat('}') {

@@ -4,6 +4,7 @@
 //! by several objects are written once, as `[meshes.NAME]`.
 
 use crate::RenderDefaults;
+use plenum_core::material::Material;
 use plenum_core::color::Color;
 use plenum_core::geometry::Shape;
 use plenum_core::light::{Attenuation, Emitter, Light};
@@ -71,6 +72,7 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
     let keys = unique_keys(&scene.material_names, "material");
     for (key, m) in keys.iter().zip(&scene.materials) {
         let _ = writeln!(w, "[materials.{}]", quote(key));
+        let Material::Phong(m) = m;
         for (name, t) in [
             ("emissive", &m.emissive),
             ("ambient", &m.ambient),
@@ -133,6 +135,7 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                 shape,
                 radiance,
                 samples,
+                ..
             } => {
                 let _ = match shape {
                     Emitter::Rectangle {
@@ -219,6 +222,7 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                 shape: Emitter::Triangles { .. },
                 radiance,
                 samples,
+                ..
             }) => writeln!(
                 w,
                 "[[objects]]\nname = {}\nemission = {}\nlight_samples = {samples}",

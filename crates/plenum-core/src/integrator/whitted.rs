@@ -53,6 +53,8 @@ pub struct RayCounts {
     pub shadow: u64,
     pub reflection: u64,
     pub refraction: u64,
+    /// Samples that came out NaN or infinite and were left out of the film.
+    pub invalid: u64,
 }
 
 impl RayCounts {
@@ -65,6 +67,7 @@ impl RayCounts {
         self.shadow += o.shadow;
         self.reflection += o.reflection;
         self.refraction += o.refraction;
+        self.invalid += o.invalid;
     }
 }
 
@@ -152,6 +155,14 @@ impl<'a> Whitted<'a> {
 
         // Local illumination: emission, ambient, and Phong from every light.
         let mut color = k.emissive + k.ambient * self.scene.ambient;
+        // A physically based area light's surface shows its radiance (a Phong emitter's
+        // k_e already does).
+        if let Some(l) = self.scene.light_of(prim) {
+            let light = &self.scene.lights[l as usize];
+            if self.scene.material_of(prim).is_physical() && light.emits_toward(it.n, v) {
+                color += light.rgb();
+            }
+        }
         // A surface that neither diffuses nor highlights (an emitter, a mirror, clear
         // glass) needs no shadow rays.
         let lit = !(k.diffuse.is_black() && k.specular.is_black());

@@ -1,10 +1,12 @@
-//! The lecture's Phong material for Whitted ray tracing. Every coefficient may be textured.
+//! The lecture's Phong material for Whitted ray tracing, with Whitted's k_r and k_t. Every
+//! coefficient may be textured. Under the physically based integrators it is read as a
+//! normalised BSDF ([`crate::bxdf::PhongBxdf`]).
 
 use crate::color::Color;
 use crate::texture::{Texture, TextureCoords};
 
 #[derive(Clone, Debug)]
-pub struct Material {
+pub struct PhongMaterial {
     /// k_e: light the surface emits on its own.
     pub emissive: Texture,
     /// k_a: response to the scene's ambient light.
@@ -29,10 +31,10 @@ pub struct Material {
     pub gloss: Option<f64>,
 }
 
-impl Default for Material {
+impl Default for PhongMaterial {
     /// A matte grey, lit by ambient light in its own colour.
     fn default() -> Self {
-        Material {
+        PhongMaterial {
             emissive: Texture::Constant(Color::BLACK),
             ambient: Texture::Constant(Color::gray(0.8)),
             diffuse: Texture::Constant(Color::gray(0.8)),
@@ -91,16 +93,33 @@ impl Coefficients {
     }
 }
 
-impl Material {
+impl PhongMaterial {
     /// The material of an area light's surface: it shows its radiance and reflects nothing.
-    pub fn emitter(radiance: Color) -> Material {
+    pub fn emitter(radiance: Color) -> PhongMaterial {
         let black = Texture::Constant(Color::BLACK);
-        Material {
+        PhongMaterial {
             emissive: Texture::Constant(radiance),
             ambient: black.clone(),
             diffuse: black.clone(),
             specular: black,
-            ..Material::default()
+            ..PhongMaterial::default()
+        }
+    }
+
+    /// The material whose coefficients are these, everywhere.
+    pub fn constant(k: &Coefficients) -> PhongMaterial {
+        let t = Texture::Constant;
+        PhongMaterial {
+            emissive: t(k.emissive),
+            ambient: t(k.ambient),
+            diffuse: t(k.diffuse),
+            specular: t(k.specular),
+            shininess: k.shininess,
+            reflective: t(k.reflective),
+            transmissive: t(k.transmissive),
+            ior: k.ior,
+            fresnel: k.fresnel,
+            gloss: k.gloss,
         }
     }
 
@@ -117,6 +136,19 @@ impl Material {
             fresnel: self.fresnel,
             gloss: self.gloss,
         }
+    }
+
+    /// Everything but the emission is black: the surface only shows its light.
+    pub fn is_emitter_only(&self) -> bool {
+        [
+            &self.ambient,
+            &self.diffuse,
+            &self.specular,
+            &self.reflective,
+            &self.transmissive,
+        ]
+        .iter()
+        .all(|t| t.is_black())
     }
 
     /// Some coefficient is looked up by texture coordinates.

@@ -1,0 +1,335 @@
+//! Unidirectional path tracing (Kajiya 1986) with next-event estimation, weighed against BSDF
+//! sampling by multiple importance sampling with the power heuristic (Veach and Guibas 1995),
+//! and Russian roulette (Arvo and Kirk 1990), on the physically based materials. The shape of
+//! pbrt-v4's `PathIntegrator` (§13.4); the Phong materials enter as their normalised BSDF.
+//!
+//! Depth: `max_depth` counts the bounces after the camera ray, as for Whitted: 0 gives direct
+//! light only, so Plenum's `max_depth` D is pbrt's `maxdepth` D + 1 and Mitsuba's `max_depth`
+//! D + 2.
+//!
+//! A camera sample's light is a [`SampledSpectrum`] at its wavelengths (or RGB lanes), turned
+//! into linear sRGB once at the end. A sample that comes out NaN or infinite is counted in
+//! [`RayCounts::invalid`] and left out of the film.
+
+use super::{IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Stop};
+use crate::accel::Coherence;
+use crate::bxdf::TransportMode;
+use crate::color::Color;
+use crate::light::{Light, LightSample};
+use crate::math::{offset_ray_origin, Ray, Vec3};
+use crate::sampling::SampleStream;
+use crate::scene::{Interaction, Scene};
+use plenum_spectrum::{ColorMode, SampledSpectrum, SampledWavelengths};
+
+pub struct PathTracer<'a> {
+    scene: &'a Scene,
+    max_depth: u32,
+    rr_depth: u32,
+    color: ColorMode,
+}
+
+/// w_a for a sample of pdf `a` against one other strategy of pdf `b`, by the power
+/// heuristic (β = 2); written as a ratio so that huge pdfs do not overflow.
+#[inline]
+pub fn power_heuristic(a: f64, b: f64) -> f64 {
+    if a.is_infinite() {
+        return 1.0;
+    }
+    if a == 0.0 {
+        return 0.0;
+    }
+    let r = b / a;
+    1.0 / (1.0 + r * r)
+}
+
+impl<'a> PathTracer<'a> {
+    pub fn new(scene: &'a Scene, config: &IntegratorConfig) -> Self {
+        PathTracer {
+            scene,
+            max_depth: config.max_depth,
+            rr_depth: config.rr_depth,
+            color: config.color,
+        }
+    }
+
+    /// Linear sRGB radiance along a camera ray. The wavelengths are the stream's next number
+    /// (spectral mode), so the sampler stratifies them across the pixel's samples.
+    pub fn camera_ray(
+        &self,
+        ray: &Ray,
+        stream: &mut SampleStream,
+        counts: &mut RayCounts,
+        tree: Option<&mut RayTree>,
+    ) -> Color {
+        counts.camera += 1;
+        let mut wl = match self.color {
+            ColorMode::Spectral => SampledWavelengths::sample_visible(stream.next_1d()),
+            ColorMode::Rgb => SampledWavelengths::rgb(),
+        };
+        let l = self.li(ray, &mut wl, stream, counts, tree);
+        if !l.is_finite() {
+            counts.invalid += 1;
+            return Color::BLACK;
+        }
+        let [r, g, b] = l.to_linear_srgb(&wl);
+        let c = Color::new(r, g, b);
+        if !(r.is_finite() && g.is_finite() && b.is_finite()) {
+            counts.invalid += 1;
+            return Color::BLACK;
+        }
+        c
+    }
+
+    /// The radiance of the path started by `ray`, at the wavelengths `wl` (which a
+    /// dispersive refraction may reduce to the hero wavelength).
+    fn li(
+        &self,
+        camera_ray: &Ray,
+        wl: &mut SampledWavelengths,
+        stream: &mut SampleStream,
+        counts: &mut RayCounts,
+        mut tree: Option<&mut RayTree>,
+    ) -> SampledSpectrum {
+        let scene = self.scene;
+        let mut l = SampledSpectrum::ZERO;
+        let mut beta = SampledSpectrum::ONE;
+        // The camera ray and specular bounces find emitters that light sampling cannot.
+        let mut specular_bounce = true;
+        // For MIS on an emitter the path hits: the BSDF pdf of the direction it left by,
+        // and the point it left from.
+        let mut pdf_bsdf = 0.0;
+        let mut previous = camera_ray.origin;
+        // The product of η² over transmissions, which radiance scaling has divided out of
+        // beta but which must not drive Russian roulette (pbrt-v4's `etaScale`).
+        let mut eta_scale = 1.0;
+        let mut ray = *camera_ray;
+        let mut kind = RayKind::Camera;
+        let mut parent = None;
+        let mut depth = 0u32;
+        loop {
+            let node = tree.as_deref_mut().map(|t| {
+                t.push(RayNode::new(
+                    parent,
+                    kind,
+                    depth,
+                    ray.origin,
+                    ray.direction,
+                    Color::from(beta.0),
+                ))
+            });
+            let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
+                let d = ray.direction.normalized();
+                let le = self.escaped(d, wl, specular_bounce, pdf_bsdf);
+                l += beta * le;
+                record(&mut tree, node, |n| {
+                    n.stops.push(Stop::Miss);
+                    n.color = Color::from((beta * le).0);
+                });
+                break;
+            };
+            let it = scene.interaction(&ray, prim, &hit);
+            let wo = -ray.direction.normalized();
+            if let Some(t) = tree.as_deref_mut() {
+                if let Some(i) = node {
+                    let n = &mut t.nodes[i];
+                    n.object = Some(scene.object_names[prim as usize].clone());
+                    let m = scene.primitives[prim as usize].material as usize;
+                    n.material = Some(scene.material_names[m].clone());
+                    n.distance = Some(hit.t * ray.direction.length());
+                }
+            }
+
+            // Light the path finds on its own, weighed against light sampling's chance of
+            // having found it.
+            if let Some(light) = scene.light_of(prim) {
+                let le = self.emitted(light, &it, wo, wl, specular_bounce, pdf_bsdf, previous);
+                l += beta * le;
+            }
+
+            let Some(bsdf) = scene.bsdf(&it, wo, wl) else {
+                record(&mut tree, node, |n| n.stops.push(Stop::Opaque));
+                break;
+            };
+            if depth >= self.max_depth && !bsdf.flags().is_non_specular() {
+                record(&mut tree, node, |n| n.stops.push(Stop::Depth));
+                break;
+            }
+            let flags = bsdf.flags();
+            if flags.is_non_specular() {
+                let ld = self.sample_light(&it, wo, &bsdf, wl, stream, counts, &ray);
+                l += beta * ld;
+            }
+            if depth >= self.max_depth {
+                record(&mut tree, node, |n| n.stops.push(Stop::Depth));
+                break;
+            }
+
+            let uc = stream.next_1d();
+            let u = stream.next_2d();
+            let Some(bs) = bsdf.sample_f(wo, uc, u, TransportMode::Radiance) else {
+                record(&mut tree, node, |n| n.stops.push(Stop::Opaque));
+                break;
+            };
+            let cos = bs.wi.dot(it.shading_n).abs();
+            beta *= bs.f * (cos / bs.pdf);
+            pdf_bsdf = if bs.pdf_is_proportional {
+                bsdf.pdf(wo, bs.wi, TransportMode::Radiance)
+            } else {
+                bs.pdf
+            };
+            specular_bounce = bs.is_specular();
+            if bs.is_transmission() {
+                eta_scale *= bs.eta * bs.eta;
+                counts.refraction += 1;
+                kind = RayKind::Refracted;
+            } else {
+                counts.reflection += 1;
+                kind = RayKind::Reflected;
+            }
+            if beta.is_black() {
+                break;
+            }
+            previous = it.p;
+            let origin = offset_ray_origin(it.p, it.p_error, it.n, bs.wi);
+            ray = Ray::new(origin, bs.wi).at_time(ray.time);
+            parent = node;
+            depth += 1;
+
+            // Russian roulette on the throughput with radiance scaling put back.
+            let rr = (beta * eta_scale).max_value();
+            if depth > self.rr_depth && rr < 1.0 {
+                let q = (1.0 - rr).max(0.0);
+                if stream.next_1d() < q {
+                    break;
+                }
+                beta /= 1.0 - q;
+            }
+        }
+        l
+    }
+
+    /// Radiance from an area light's surface toward `wo`, MIS-weighted unless the path
+    /// arrived by a specular bounce (or is the camera ray).
+    #[allow(clippy::too_many_arguments)]
+    fn emitted(
+        &self,
+        light: u32,
+        it: &Interaction,
+        wo: Vec3,
+        wl: &SampledWavelengths,
+        specular_bounce: bool,
+        pdf_bsdf: f64,
+        from: Vec3,
+    ) -> SampledSpectrum {
+        let scene = self.scene;
+        let l = &scene.lights[light as usize];
+        if !l.emits_toward(it.n, wo) {
+            return SampledSpectrum::ZERO;
+        }
+        let le = scene.light_spectrum(light, wl);
+        if specular_bounce {
+            return le;
+        }
+        let pdf_light = scene.light_sampler.pmf(light) * l.pdf_li(from, it.p, it.n);
+        le * power_heuristic(pdf_bsdf, pdf_light)
+    }
+
+    /// Radiance arriving from infinity along `d`: the infinite lights, MIS-weighted, and the
+    /// background colour (which no strategy but this one finds).
+    fn escaped(
+        &self,
+        d: Vec3,
+        wl: &SampledWavelengths,
+        specular_bounce: bool,
+        pdf_bsdf: f64,
+    ) -> SampledSpectrum {
+        let scene = self.scene;
+        let mut le = scene.background_spectrum(wl);
+        for &i in &scene.infinite_lights {
+            let light = &scene.lights[i as usize];
+            let radiance = scene.light_spectrum(i, wl);
+            if specular_bounce {
+                le += radiance;
+            } else {
+                let pdf_light = scene.light_sampler.pmf(i) * light.pdf_li(Vec3::ZERO, d, d);
+                le += radiance * power_heuristic(pdf_bsdf, pdf_light);
+            }
+        }
+        le
+    }
+
+    /// Next-event estimation: one light chosen by the light sampler, a point or direction on
+    /// it, a shadow ray, MIS-weighted against the BSDF's chance of that direction.
+    #[allow(clippy::too_many_arguments)]
+    fn sample_light(
+        &self,
+        it: &Interaction,
+        wo: Vec3,
+        bsdf: &crate::bxdf::Bsdf,
+        wl: &SampledWavelengths,
+        stream: &mut SampleStream,
+        counts: &mut RayCounts,
+        ray: &Ray,
+    ) -> SampledSpectrum {
+        let scene = self.scene;
+        let ul = stream.next_1d();
+        let u = stream.next_2d();
+        let Some((index, pmf)) = scene.light_sampler.sample(ul) else {
+            return SampledSpectrum::ZERO;
+        };
+        let light = &scene.lights[index as usize];
+        let Some(ls) = light.sample_li(it.p, u) else {
+            return SampledSpectrum::ZERO;
+        };
+        if ls.scale == 0.0 || ls.pdf == 0.0 {
+            return SampledSpectrum::ZERO;
+        }
+        let f = bsdf.f(wo, ls.wi, TransportMode::Radiance) * ls.wi.dot(it.shading_n).abs();
+        if f.is_black() {
+            return SampledSpectrum::ZERO;
+        }
+        counts.shadow += 1;
+        if self.occluded(it, &ls, ray.time) {
+            return SampledSpectrum::ZERO;
+        }
+        let le = scene.light_spectrum(index, wl) * ls.scale;
+        let pdf_light = pmf * ls.pdf;
+        if ls.delta {
+            return f * le / pdf_light;
+        }
+        let pdf_bsdf = bsdf.pdf(wo, ls.wi, TransportMode::Radiance);
+        f * le * (power_heuristic(pdf_light, pdf_bsdf) / pdf_light)
+    }
+
+    /// Whether anything opaque or not lies between the shaded point and the light sample:
+    /// in a physically based scene glass casts a shadow, and the light through it arrives
+    /// by BSDF sampling.
+    fn occluded(&self, it: &Interaction, ls: &LightSample, time: f64) -> bool {
+        let origin = offset_ray_origin(it.p, it.p_error, it.n, ls.wi);
+        let (shadow, t_max) = match ls.position {
+            Some(q) => (Ray::new(origin, q - origin), ls.shadow_end),
+            None => (Ray::new(origin, ls.wi), f64::INFINITY),
+        };
+        self.scene
+            .occluded(&shadow.at_time(time), t_max, Coherence::Incoherent)
+    }
+}
+
+fn record(tree: &mut Option<&mut RayTree>, node: Option<usize>, f: impl FnOnce(&mut RayNode)) {
+    if let (Some(t), Some(i)) = (tree.as_deref_mut(), node) {
+        f(&mut t.nodes[i]);
+    }
+}
+
+impl From<[f64; 4]> for Color {
+    /// The first three lanes of a sampled spectrum, as seen in RGB mode (the ray tree's
+    /// weights; spectral lanes are shown as they are).
+    fn from(v: [f64; 4]) -> Color {
+        Color::new(v[0], v[1], v[2])
+    }
+}
+
+/// A light as the light sampler sees it.
+pub(crate) fn is_infinite(light: &Light) -> bool {
+    matches!(light, Light::Infinite { .. })
+}

@@ -1,0 +1,179 @@
+//! Material parameters that may vary over a surface and with wavelength.
+//!
+//! A [`SpectralTexture`] is a spectrum the same everywhere (RGB uplifted once, a named
+//! measured spectrum, a blackbody, a piecewise-linear list) or an RGB texture uplifted at each
+//! lookup (Jakob and Hanika 2019, through the shared coefficient table). Which of pbrt-v4's
+//! three kinds of uplift applies is the parameter's [`SpectrumKind`]: reflectances are
+//! bounded by 1, indices of refraction are not, emitters are illuminants.
+
+use crate::color::Color;
+use crate::texture::{Texture, TextureCoords};
+use plenum_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
+
+/// How an RGB value becomes a spectrum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpectrumKind {
+    /// Reflectance or transmittance: clamped to [0, 1].
+    Albedo,
+    /// Any non-negative value (η, k).
+    Unbounded,
+    /// Emitted radiance: times the colour space's illuminant (D65 for sRGB).
+    Illuminant,
+}
+
+/// The spectrum of an RGB value of that kind.
+pub fn uplift(c: Color, kind: SpectrumKind) -> Spectrum {
+    let rgb = [c.r, c.g, c.b];
+    match kind {
+        SpectrumKind::Albedo => Spectrum::rgb_albedo(rgb),
+        SpectrumKind::Unbounded => Spectrum::rgb_unbounded(rgb),
+        SpectrumKind::Illuminant => Spectrum::rgb_illuminant(rgb),
+    }
+}
+
+/// A spectrum with its RGB projection kept for RGB mode.
+#[derive(Clone, Debug)]
+pub struct SpectrumValue {
+    spectrum: Spectrum,
+    rgb: [f64; 3],
+}
+
+impl SpectrumValue {
+    pub fn new(spectrum: Spectrum, kind: SpectrumKind) -> SpectrumValue {
+        let rgb = match kind {
+            SpectrumKind::Illuminant => spectrum.to_rgb_illuminant(),
+            _ => spectrum.to_rgb_reflectance(),
+        };
+        SpectrumValue { spectrum, rgb }
+    }
+
+    pub fn from_rgb(c: Color, kind: SpectrumKind) -> SpectrumValue {
+        SpectrumValue {
+            spectrum: uplift(c, kind),
+            rgb: [c.r, c.g, c.b],
+        }
+    }
+
+    #[inline]
+    pub fn sample(&self, wl: &SampledWavelengths) -> SampledSpectrum {
+        if wl.is_rgb() {
+            let [r, g, b] = self.rgb;
+            SampledSpectrum([r, g, b, 0.0])
+        } else {
+            self.spectrum.sample(wl)
+        }
+    }
+
+    pub fn rgb(&self) -> Color {
+        Color::new(self.rgb[0], self.rgb[1], self.rgb[2])
+    }
+
+    pub fn spectrum(&self) -> &Spectrum {
+        &self.spectrum
+    }
+}
+
+#[derive(Clone, Debug)]
+pub enum SpectralTexture {
+    Constant(SpectrumValue),
+    /// An RGB texture, uplifted per lookup.
+    Rgb { texture: Texture, kind: SpectrumKind },
+}
+
+impl SpectralTexture {
+    /// An RGB texture; a constant one is uplifted once, here.
+    pub fn from_texture(texture: Texture, kind: SpectrumKind) -> SpectralTexture {
+        match texture {
+            Texture::Constant(c) => SpectralTexture::Constant(SpectrumValue::from_rgb(c, kind)),
+            texture => SpectralTexture::Rgb { texture, kind },
+        }
+    }
+
+    pub fn constant(c: Color, kind: SpectrumKind) -> SpectralTexture {
+        SpectralTexture::Constant(SpectrumValue::from_rgb(c, kind))
+    }
+
+    #[inline]
+    pub fn evaluate(&self, at: &TextureCoords, wl: &SampledWavelengths) -> SampledSpectrum {
+        match self {
+            SpectralTexture::Constant(v) => v.sample(wl),
+            SpectralTexture::Rgb { texture, kind } => {
+                let mut c = texture.evaluate(at);
+                if *kind == SpectrumKind::Albedo {
+                    c = Color::new(c.r.clamp(0.0, 1.0), c.g.clamp(0.0, 1.0), c.b.clamp(0.0, 1.0));
+                }
+                if wl.is_rgb() {
+                    SampledSpectrum([c.r, c.g, c.b, 0.0])
+                } else {
+                    uplift_at(c, *kind, wl)
+                }
+            }
+        }
+    }
+
+    /// The RGB value the parameter shows in Whitted's model (a texture's at this point).
+    pub fn rgb(&self, at: &TextureCoords) -> Color {
+        match self {
+            SpectralTexture::Constant(v) => v.rgb(),
+            SpectralTexture::Rgb { texture, .. } => texture.evaluate(at),
+        }
+    }
+
+    pub fn needs_uv(&self) -> bool {
+        matches!(
+            self,
+            SpectralTexture::Rgb {
+                texture: Texture::Checker2d { .. } | Texture::Image(_),
+                ..
+            }
+        )
+    }
+
+    /// The same value at every wavelength, so that a dielectric of this η does not disperse.
+    pub fn is_constant(&self) -> bool {
+        match self {
+            SpectralTexture::Constant(v) => v.spectrum().is_constant(),
+            SpectralTexture::Rgb { .. } => false,
+        }
+    }
+}
+
+/// An RGB value's spectrum at the sample's wavelengths, through the shared table.
+pub(crate) fn uplift_at(c: Color, kind: SpectrumKind, wl: &SampledWavelengths) -> SampledSpectrum {
+    plenum_spectrum::uplift_sample([c.r, c.g, c.b], kind_of(kind), wl)
+}
+
+fn kind_of(kind: SpectrumKind) -> plenum_spectrum::RgbKind {
+    match kind {
+        SpectrumKind::Albedo => plenum_spectrum::RgbKind::Albedo,
+        SpectrumKind::Unbounded => plenum_spectrum::RgbKind::Unbounded,
+        SpectrumKind::Illuminant => plenum_spectrum::RgbKind::Illuminant,
+    }
+}
+
+/// A scalar parameter: a constant or a texture's mean channel.
+#[derive(Clone, Debug)]
+pub enum FloatTexture {
+    Constant(f64),
+    Texture(Texture),
+}
+
+impl FloatTexture {
+    #[inline]
+    pub fn evaluate(&self, at: &TextureCoords) -> f64 {
+        match self {
+            FloatTexture::Constant(v) => *v,
+            FloatTexture::Texture(t) => {
+                let c = t.evaluate(at);
+                (c.r + c.g + c.b) / 3.0
+            }
+        }
+    }
+
+    pub fn needs_uv(&self) -> bool {
+        matches!(
+            self,
+            FloatTexture::Texture(Texture::Checker2d { .. } | Texture::Image(_))
+        )
+    }
+}
