@@ -1,0 +1,365 @@
+//! Physically based BSDFs: what fraction of the light arriving from one direction a surface
+//! sends into another, per wavelength lane of a [`SampledSpectrum`].
+//!
+//! The models and their maths follow pbrt-v4 (Pharr, Jakob & Humphreys, *Physically Based
+//! Rendering*, 4th ed., chapters 9–10 and 14): Lambert, Torrance–Sparrow microfacets with
+//! the Trowbridge–Reitz (GGX) distribution sampled by visible normals (Heitz 2018), smooth
+//! and rough dielectrics (Walter et al. 2007), thin dielectric sheets, diffuse transmission,
+//! a coated diffuse surface by a stochastic random walk between layers (Guo et al. 2018, as
+//! pbrt-v4's `LayeredBxDF`), and the Phong material read as a normalised BSDF.
+//!
+//! **The one direction convention.** `wo` and `wi` point *away* from the surface and are
+//! given in the shading frame: z is the shading normal, pointing up (out of the surface),
+//! x and y span the tangent plane. cos θ of a direction is its z component. `wo` is the
+//! direction light leaves towards (the camera side in a path tracer), `wi` the one it
+//! arrives from. A [`Bxdf`] works in this frame only; a [`Bsdf`] carries world directions
+//! into it and back.
+//!
+//! Values: `f` is the BSDF in 1/sr; `pdf` a density per steradian of `wi`; delta lobes
+//! (mirrors, smooth interfaces) have `f = 0` and `pdf = 0` and are reached only through
+//! `sample_f`, which returns their weight as `f` with `pdf` the discrete probability of the
+//! lobe (so that f·|cos θi|/pdf is the throughput weight either way).
+
+mod conductor;
+mod dielectric;
+mod diffuse;
+mod diffuse_transmission;
+pub mod fresnel;
+mod layered;
+pub mod microfacet;
+mod phong;
+mod thin_dielectric;
+
+#[cfg(test)]
+mod test_support;
+
+pub use conductor::ConductorBxdf;
+pub use dielectric::DielectricBxdf;
+pub use diffuse::DiffuseBxdf;
+pub use diffuse_transmission::DiffuseTransmissionBxdf;
+pub use layered::CoatedDiffuseBxdf;
+pub use microfacet::TrowbridgeReitz;
+pub use phong::PhongBxdf;
+pub use thin_dielectric::ThinDielectricBxdf;
+
+use std::ops::BitOr;
+
+use plenum_spectrum::SampledSpectrum;
+
+use crate::math::Vec3;
+use crate::sampling::Frame;
+
+/// Which quantity a path carries, so that non-symmetric BSDFs scale correctly.
+///
+/// Refraction compresses radiance by 1/η² (the solid angle narrows) but not importance:
+/// camera paths carry `Radiance`; light paths (light tracing, photon mapping, the light
+/// half of BDPT) carry `Importance`, the adjoint, without that factor.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum TransportMode {
+    Radiance,
+    Importance,
+}
+
+/// The kinds of lobe a BSDF has or a sample came from.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub struct BxdfFlags(u8);
+
+impl BxdfFlags {
+    pub const UNSET: BxdfFlags = BxdfFlags(0);
+    pub const REFLECTION: BxdfFlags = BxdfFlags(1);
+    pub const TRANSMISSION: BxdfFlags = BxdfFlags(2);
+    pub const DIFFUSE: BxdfFlags = BxdfFlags(4);
+    pub const GLOSSY: BxdfFlags = BxdfFlags(8);
+    pub const SPECULAR: BxdfFlags = BxdfFlags(16);
+
+    pub const DIFFUSE_REFLECTION: BxdfFlags = BxdfFlags(1 | 4);
+    pub const DIFFUSE_TRANSMISSION: BxdfFlags = BxdfFlags(2 | 4);
+    pub const GLOSSY_REFLECTION: BxdfFlags = BxdfFlags(1 | 8);
+    pub const GLOSSY_TRANSMISSION: BxdfFlags = BxdfFlags(2 | 8);
+    pub const SPECULAR_REFLECTION: BxdfFlags = BxdfFlags(1 | 16);
+    pub const SPECULAR_TRANSMISSION: BxdfFlags = BxdfFlags(2 | 16);
+
+    /// Every bit of `other` is set here.
+    pub fn contains(self, other: BxdfFlags) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    pub fn is_specular(self) -> bool {
+        self.0 & Self::SPECULAR.0 != 0
+    }
+
+    /// Has a diffuse or glossy lobe, one that `f` and `pdf` can see.
+    pub fn is_non_specular(self) -> bool {
+        self.0 & (Self::DIFFUSE.0 | Self::GLOSSY.0) != 0
+    }
+
+    pub fn is_reflective(self) -> bool {
+        self.0 & Self::REFLECTION.0 != 0
+    }
+
+    pub fn is_transmissive(self) -> bool {
+        self.0 & Self::TRANSMISSION.0 != 0
+    }
+}
+
+impl BitOr for BxdfFlags {
+    type Output = BxdfFlags;
+    fn bitor(self, o: BxdfFlags) -> BxdfFlags {
+        BxdfFlags(self.0 | o.0)
+    }
+}
+
+/// Which hemispheres, relative to `wo`, `sample_f` may return and `pdf` accounts for
+/// (pbrt-v4's `BxDFReflTransFlags`); the layered model asks for one side at a time.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum SampleFlags {
+    All,
+    Reflection,
+    Transmission,
+}
+
+impl SampleFlags {
+    pub fn reflection(self) -> bool {
+        self != SampleFlags::Transmission
+    }
+
+    pub fn transmission(self) -> bool {
+        self != SampleFlags::Reflection
+    }
+}
+
+/// One sampled scattering event.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    /// The BSDF value for (wo, wi), 1/sr; for a delta lobe its weight divided by |cos θi|.
+    pub f: SampledSpectrum,
+    /// The sampled incident direction, unit length, pointing away from the surface.
+    pub wi: Vec3,
+    /// Per steradian for a continuous lobe; the discrete probability for a delta lobe.
+    pub pdf: f64,
+    pub flags: BxdfFlags,
+    /// The relative index of refraction across the event, η_transmitted/η_incident as
+    /// seen from wo's side; 1 for reflection.
+    pub eta: f64,
+    /// `pdf` is only proportional to the true density (a stochastic estimate, as in the
+    /// layered model): use it for weights f/pdf, not in MIS heuristics.
+    pub pdf_is_proportional: bool,
+}
+
+impl BsdfSample {
+    fn new(f: SampledSpectrum, wi: Vec3, pdf: f64, flags: BxdfFlags) -> BsdfSample {
+        BsdfSample {
+            f,
+            wi,
+            pdf,
+            flags,
+            eta: 1.0,
+            pdf_is_proportional: false,
+        }
+    }
+
+    fn with_eta(self, eta: f64) -> BsdfSample {
+        BsdfSample { eta, ..self }
+    }
+
+    pub fn is_specular(&self) -> bool {
+        self.flags.is_specular()
+    }
+
+    pub fn is_reflection(&self) -> bool {
+        self.flags.is_reflective()
+    }
+
+    pub fn is_transmission(&self) -> bool {
+        self.flags.is_transmissive()
+    }
+}
+
+/// Every BSDF model, a small value built per hit; dispatch is by `match`.
+#[derive(Clone, Copy, Debug)]
+pub enum Bxdf {
+    Diffuse(DiffuseBxdf),
+    Conductor(ConductorBxdf),
+    Dielectric(DielectricBxdf),
+    ThinDielectric(ThinDielectricBxdf),
+    DiffuseTransmission(DiffuseTransmissionBxdf),
+    CoatedDiffuse(CoatedDiffuseBxdf),
+    Phong(PhongBxdf),
+}
+
+impl Bxdf {
+    /// The BSDF for light arriving from `wi` and leaving to `wo`, 1/sr; 0 for delta lobes.
+    pub fn f(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> SampledSpectrum {
+        match self {
+            Bxdf::Diffuse(b) => b.f(wo, wi, mode),
+            Bxdf::Conductor(b) => b.f(wo, wi, mode),
+            Bxdf::Dielectric(b) => b.f(wo, wi, mode),
+            Bxdf::ThinDielectric(b) => b.f(wo, wi, mode),
+            Bxdf::DiffuseTransmission(b) => b.f(wo, wi, mode),
+            Bxdf::CoatedDiffuse(b) => b.f(wo, wi, mode),
+            Bxdf::Phong(b) => b.f(wo, wi, mode),
+        }
+    }
+
+    /// Draws wi given wo from `uc` (chooses a lobe) and `u` (the direction), all in [0, 1).
+    pub fn sample_f(
+        &self,
+        wo: Vec3,
+        uc: f64,
+        u: [f64; 2],
+        mode: TransportMode,
+        which: SampleFlags,
+    ) -> Option<BsdfSample> {
+        match self {
+            Bxdf::Diffuse(b) => b.sample_f(wo, uc, u, mode, which),
+            Bxdf::Conductor(b) => b.sample_f(wo, uc, u, mode, which),
+            Bxdf::Dielectric(b) => b.sample_f(wo, uc, u, mode, which),
+            Bxdf::ThinDielectric(b) => b.sample_f(wo, uc, u, mode, which),
+            Bxdf::DiffuseTransmission(b) => b.sample_f(wo, uc, u, mode, which),
+            Bxdf::CoatedDiffuse(b) => b.sample_f(wo, uc, u, mode, which),
+            Bxdf::Phong(b) => b.sample_f(wo, uc, u, mode, which),
+        }
+    }
+
+    /// The density per steradian with which `sample_f` returns `wi`, continuous lobes only.
+    pub fn pdf(&self, wo: Vec3, wi: Vec3, mode: TransportMode, which: SampleFlags) -> f64 {
+        match self {
+            Bxdf::Diffuse(b) => b.pdf(wo, wi, mode, which),
+            Bxdf::Conductor(b) => b.pdf(wo, wi, mode, which),
+            Bxdf::Dielectric(b) => b.pdf(wo, wi, mode, which),
+            Bxdf::ThinDielectric(b) => b.pdf(wo, wi, mode, which),
+            Bxdf::DiffuseTransmission(b) => b.pdf(wo, wi, mode, which),
+            Bxdf::CoatedDiffuse(b) => b.pdf(wo, wi, mode, which),
+            Bxdf::Phong(b) => b.pdf(wo, wi, mode, which),
+        }
+    }
+
+    pub fn flags(&self) -> BxdfFlags {
+        match self {
+            Bxdf::Diffuse(b) => b.flags(),
+            Bxdf::Conductor(b) => b.flags(),
+            Bxdf::Dielectric(b) => b.flags(),
+            Bxdf::ThinDielectric(b) => b.flags(),
+            Bxdf::DiffuseTransmission(b) => b.flags(),
+            Bxdf::CoatedDiffuse(b) => b.flags(),
+            Bxdf::Phong(b) => b.flags(),
+        }
+    }
+}
+
+/// A [`Bxdf`] placed in a shading frame: the interface integrators use, in world space.
+#[derive(Clone, Copy, Debug)]
+pub struct Bsdf {
+    frame: Frame,
+    bxdf: Bxdf,
+}
+
+impl Bsdf {
+    /// The frame has z = `shading_normal` (unit length) and, when `dpdu_hint` is given and
+    /// not parallel to it, x along the hint projected onto the tangent plane, which orients
+    /// anisotropic lobes; otherwise any tangent.
+    pub fn new(shading_normal: Vec3, dpdu_hint: Option<Vec3>, bxdf: Bxdf) -> Bsdf {
+        let n = shading_normal;
+        let tangent = dpdu_hint
+            .map(|t| t - n * n.dot(t))
+            .filter(|t| t.length_squared() > 1e-12 * n.length_squared());
+        let frame = match tangent {
+            Some(t) => {
+                let x = t.normalized();
+                Frame { x, y: n.cross(x), z: n }
+            }
+            None => Frame::from_z(n),
+        };
+        Bsdf { frame, bxdf }
+    }
+
+    pub fn bxdf(&self) -> &Bxdf {
+        &self.bxdf
+    }
+
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        self.frame.to_local(v)
+    }
+
+    pub fn to_world(&self, v: Vec3) -> Vec3 {
+        self.frame.to_world(v)
+    }
+
+    pub fn flags(&self) -> BxdfFlags {
+        self.bxdf.flags()
+    }
+
+    pub fn f(&self, wo_world: Vec3, wi_world: Vec3, mode: TransportMode) -> SampledSpectrum {
+        let wo = self.to_local(wo_world);
+        if wo.z == 0.0 {
+            return SampledSpectrum::ZERO;
+        }
+        self.bxdf.f(wo, self.to_local(wi_world), mode)
+    }
+
+    /// As [`Bxdf::sample_f`], with wo and the returned wi in world space; `None` also for
+    /// samples that carry nothing (f black, pdf 0, wi in the tangent plane).
+    pub fn sample_f(
+        &self,
+        wo_world: Vec3,
+        uc: f64,
+        u: [f64; 2],
+        mode: TransportMode,
+    ) -> Option<BsdfSample> {
+        let wo = self.to_local(wo_world);
+        if wo.z == 0.0 || self.flags().is_empty() {
+            return None;
+        }
+        let sample = self.bxdf.sample_f(wo, uc, u, mode, SampleFlags::All)?;
+        if sample.f.is_black() || sample.pdf == 0.0 || sample.wi.z == 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            wi: self.to_world(sample.wi),
+            ..sample
+        })
+    }
+
+    pub fn pdf(&self, wo_world: Vec3, wi_world: Vec3, mode: TransportMode) -> f64 {
+        let wo = self.to_local(wo_world);
+        if wo.z == 0.0 {
+            return 0.0;
+        }
+        self.bxdf
+            .pdf(wo, self.to_local(wi_world), mode, SampleFlags::All)
+    }
+}
+
+/// wo and wi on the same side of the surface.
+fn same_hemisphere(a: Vec3, b: Vec3) -> bool {
+    a.z * b.z > 0.0
+}
+
+/// The mirror image of `wo` about the normal `n` (both pointing away from the surface).
+fn reflect(wo: Vec3, n: Vec3) -> Vec3 {
+    n * (2.0 * wo.dot(n)) - wo
+}
+
+/// The direction `wi` refracts into through a surface of normal `n` and relative index
+/// `eta` (inside over outside, the inside being opposite `n`), with the relative index
+/// actually crossed; `None` under total internal reflection. `wi` may arrive from either
+/// side: from the side opposite `n`, the interface is seen with 1/eta.
+fn refract(wi: Vec3, n: Vec3, eta: f64) -> Option<(Vec3, f64)> {
+    let (mut n, mut eta, mut cos_i) = (n, eta, n.dot(wi));
+    if cos_i < 0.0 {
+        eta = 1.0 / eta;
+        cos_i = -cos_i;
+        n = -n;
+    }
+    let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
+    let sin2_t = sin2_i / (eta * eta);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
+    Some((-wi / eta + n * (cos_i / eta - cos_t), eta))
+}
