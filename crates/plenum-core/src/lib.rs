@@ -6,6 +6,7 @@
 pub mod accel;
 pub mod camera;
 pub mod color;
+pub mod environment;
 pub mod film;
 pub mod geometry;
 pub mod integrator;

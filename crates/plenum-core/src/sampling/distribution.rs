@@ -219,7 +219,10 @@ impl PiecewiseConstant2D {
     /// The u that [`sample`](Self::sample) maps to p, or None outside the square.
     pub fn invert(&self, p: [f64; 2]) -> Option<[f64; 2]> {
         let row = self.marginal.cell_of(p[1])?;
-        Some([self.conditionals[row].invert(p[0])?, self.marginal.invert(p[1])?])
+        Some([
+            self.conditionals[row].invert(p[0])?,
+            self.marginal.invert(p[1])?,
+        ])
     }
 }
 
@@ -249,7 +252,10 @@ impl AliasTable {
     ///
     /// Panics if `weights` is empty: there is nothing to sample.
     pub fn new(weights: &[f64]) -> AliasTable {
-        assert!(!weights.is_empty(), "an alias table needs at least one weight");
+        assert!(
+            !weights.is_empty(),
+            "an alias table needs at least one weight"
+        );
         let n = weights.len();
         let clean: Vec<f64> = weights
             .iter()
@@ -399,7 +405,10 @@ mod tests {
         for _ in 0..100_000 {
             let u = rng.uniform();
             let (x, pdf, offset) = f.sample_continuous(u);
-            assert!(values()[offset] > 0.0, "zero cell {offset} sampled at u = {u}");
+            assert!(
+                values()[offset] > 0.0,
+                "zero cell {offset} sampled at u = {u}"
+            );
             assert!((-1.0..=2.0).contains(&x));
             assert_eq!(pdf, f.pdf(x), "at {x}");
             let back = f.invert(x).unwrap();
@@ -451,7 +460,10 @@ mod tests {
             .collect();
         assert!((expected.iter().sum::<f64>() - 1.0).abs() < 1e-12);
         let p = discrete_p_value(&observed, &expected);
-        assert!(p >= rejection_level(), "1-D piecewise constant: p = {p:.3e}");
+        assert!(
+            p >= rejection_level(),
+            "1-D piecewise constant: p = {p:.3e}"
+        );
     }
 
     /// A 7 × 5 grid with zero cells, zero rows and one bright cell.
@@ -493,7 +505,11 @@ mod tests {
             let (p, pdf) = grid.sample(u);
             let cell = ((p[1] * 5.0) as usize).min(4) * 7 + ((p[0] * 7.0) as usize).min(6);
             assert!(values[cell] > 0.0, "zero cell {cell} sampled at {u:?}");
-            assert!((pdf - grid.pdf(p)).abs() <= 1e-12 * pdf, "{pdf} vs {}", grid.pdf(p));
+            assert!(
+                (pdf - grid.pdf(p)).abs() <= 1e-12 * pdf,
+                "{pdf} vs {}",
+                grid.pdf(p)
+            );
             assert!((pdf - values[cell] / grid.integral()).abs() <= 1e-12 * pdf);
             let back = grid.invert(p).unwrap();
             assert!((back[0] - u[0]).abs() < 1e-9 && (back[1] - u[1]).abs() < 1e-9);
@@ -542,7 +558,9 @@ mod tests {
     }
 
     fn weights() -> Vec<f64> {
-        vec![0.0, 5.0, 1.0, 0.0, 0.25, 10.0, 3.0, 0.0, 1e-3, 7.0, 2.0, 0.0]
+        vec![
+            0.0, 5.0, 1.0, 0.0, 0.25, 10.0, 3.0, 0.0, 1e-3, 7.0, 2.0, 0.0,
+        ]
     }
 
     #[test]
@@ -595,7 +613,10 @@ mod tests {
         // The remapped number is uniform: a loose check (not counted as a chi-square test),
         // each decile within 1.5e-3 of a tenth, five standard deviations.
         for count in remapped {
-            assert!((count as f64 / SAMPLES as f64 - 0.1).abs() < 1.5e-3, "{remapped:?}");
+            assert!(
+                (count as f64 / SAMPLES as f64 - 0.1).abs() < 1.5e-3,
+                "{remapped:?}"
+            );
         }
     }
 

@@ -720,7 +720,10 @@ mod equal_area_tests {
             let w = uniform_sphere([rng.uniform(), rng.uniform()]);
             let q = equal_area_sphere_to_square(w);
             assert!((0.0..=1.0).contains(&q[0]) && (0.0..=1.0).contains(&q[1]));
-            assert!((equal_area_square_to_sphere(q) - w).length() < 1e-9, "{w:?}");
+            assert!(
+                (equal_area_square_to_sphere(q) - w).length() < 1e-9,
+                "{w:?}"
+            );
         }
         // Poles, equator and the lower pole at the corners.
         assert!((equal_area_square_to_sphere([0.5, 0.5]) - Vec3::Z).length() < 1e-15);
@@ -790,7 +793,10 @@ mod equal_area_tests {
                 (w1 - w0) / (2.0 * h)
             };
             let jacobian = d([h, 0.0]).cross(d([0.0, h])).length();
-            assert!((jacobian / (4.0 * PI) - 1.0).abs() < 1e-5, "{p:?}: {jacobian}");
+            assert!(
+                (jacobian / (4.0 * PI) - 1.0).abs() < 1e-5,
+                "{p:?}: {jacobian}"
+            );
             checked += 1;
         }
     }
