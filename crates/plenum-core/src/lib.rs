@@ -7,6 +7,7 @@ pub mod accel;
 pub mod bxdf;
 pub mod camera;
 pub mod color;
+pub mod environment;
 pub mod film;
 pub mod geometry;
 pub mod integrator;

@@ -591,3 +591,236 @@ mod tests {
         assert!(!outcome.accepted(), "{outcome:?}");
     }
 }
+
+// The equal-area octahedral map between the square and the sphere (Clarberg 2008, "Fast
+// Equal-Area Mapping of the (Hemi)Sphere using SIMD", as pbrt-v4 §3.8.3 uses it for
+// environment maps). The square [0, 1]² is folded like an octahedron: the inner diamond
+// |a| + |b| ≤ 1 of (a, b) = 2p − 1 covers the upper hemisphere z ≥ 0, the four corner
+// triangles the lower one, and each of the square's edges is glued to itself mirrored about
+// its midpoint. Concentric diamonds go to circles of latitude, so the map is continuous and
+// its Jacobian is 4π everywhere: uniform points give uniform directions.
+
+/// The unit direction for a point p in [0, 1]² of the equal-area square (Clarberg 2008);
+/// density [`SPHERE_PDF`] per steradian for uniform p.
+pub fn equal_area_square_to_sphere(p: [f64; 2]) -> Vec3 {
+    let a = 2.0 * p[0] - 1.0;
+    let b = 2.0 * p[1] - 1.0;
+    // The signed distance from the diamond |a| + |b| = 1: positive inside (upper hemisphere).
+    let signed_distance = 1.0 - (a.abs() + b.abs());
+    // r is the diamond's "radius", 0 at the poles and 1 on the equator.
+    let r = 1.0 - signed_distance.abs();
+    // The angle within the quadrant, proportional to the position along the diamond's side.
+    let phi = if r == 0.0 {
+        FRAC_PI_4
+    } else {
+        ((b.abs() - a.abs()) / r + 1.0) * FRAC_PI_4
+    };
+    // 1 − |z| = r² gives equal areas: the cap |z| ≥ 1 − r² has area 2πr², its diamond 2r².
+    let z = (1.0 - r * r).copysign(signed_distance);
+    let sin_theta = r * (2.0 - r * r).max(0.0).sqrt();
+    let (sin_phi, cos_phi) = phi.sin_cos();
+    Vec3::new(
+        (cos_phi * sin_theta).copysign(a),
+        (sin_phi * sin_theta).copysign(b),
+        z,
+    )
+}
+
+/// The point of [0, 1]² that [`equal_area_square_to_sphere`] maps to the unit direction `w`.
+pub fn equal_area_sphere_to_square(w: Vec3) -> [f64; 2] {
+    let (x, y, z) = (w.x.abs(), w.y.abs(), w.z.abs());
+    let r = (1.0 - z).max(0.0).sqrt();
+    // The angle within the quadrant as a fraction of π/2, from the smaller over the larger
+    // component so that the arctangent's argument stays in [0, 1].
+    let (large, small) = (x.max(y), x.min(y));
+    let ratio = if large == 0.0 { 0.0 } else { small / large };
+    let mut phi = ratio.atan() / FRAC_PI_2;
+    if x < y {
+        phi = 1.0 - phi;
+    }
+    let mut b = phi * r;
+    let mut a = r - b;
+    if w.z < 0.0 {
+        // The lower hemisphere fills the corner triangles: reflect across the diamond's side.
+        (a, b) = (1.0 - b, 1.0 - a);
+    }
+    let a = a.copysign(w.x);
+    let b = b.copysign(w.y);
+    [0.5 * (a + 1.0), 0.5 * (b + 1.0)]
+}
+
+/// A point of the plane carried into [0, 1]² by the equal-area square's edge gluing, for
+/// points at most one square's width outside it (as bilinear filtering produces): across
+/// each edge the square continues mirrored, turned half a turn about that edge's midpoint.
+pub fn wrap_equal_area_square(p: [f64; 2]) -> [f64; 2] {
+    let [mut s, mut t] = p;
+    if s < 0.0 {
+        s = -s;
+        t = 1.0 - t;
+    } else if s > 1.0 {
+        s = 2.0 - s;
+        t = 1.0 - t;
+    }
+    if t < 0.0 {
+        s = 1.0 - s;
+        t = -t;
+    } else if t > 1.0 {
+        s = 1.0 - s;
+        t = 2.0 - t;
+    }
+    [s, t]
+}
+
+/// The texel (column, row) of an n × n equal-area image that texel (x, y) names, for x and y
+/// at most n outside [0, n): the discrete form of [`wrap_equal_area_square`], where texel
+/// −1 is the mirror of texel 0 across the edge.
+pub fn wrap_equal_area_texel(x: i64, y: i64, n: usize) -> (usize, usize) {
+    let n = n as i64;
+    let (mut x, mut y) = (x, y);
+    if x < 0 {
+        x = -1 - x;
+        y = n - 1 - y;
+    } else if x >= n {
+        x = 2 * n - 1 - x;
+        y = n - 1 - y;
+    }
+    if y < 0 {
+        x = n - 1 - x;
+        y = -1 - y;
+    } else if y >= n {
+        x = n - 1 - x;
+        y = 2 * n - 1 - y;
+    }
+    (x.clamp(0, n - 1) as usize, y.clamp(0, n - 1) as usize)
+}
+
+#[cfg(test)]
+mod equal_area_tests {
+    use std::f64::consts::PI;
+
+    use super::*;
+    use crate::sampling::chi_square::{PlanarBins, SphericalBins};
+    use crate::sampling::Rng;
+
+    const SEED: u64 = 0x5EED00EA;
+    const SAMPLES: usize = 1_000_000;
+
+    #[test]
+    fn round_trips() {
+        let mut rng = Rng::new(SEED, 1);
+        for _ in 0..100_000 {
+            let p = [rng.uniform(), rng.uniform()];
+            let w = equal_area_square_to_sphere(p);
+            assert!((w.length() - 1.0).abs() < 1e-12, "{p:?} → {w:?}");
+            let back = equal_area_sphere_to_square(w);
+            assert!(
+                (back[0] - p[0]).abs() < 1e-9 && (back[1] - p[1]).abs() < 1e-9,
+                "{p:?} → {w:?} → {back:?}"
+            );
+            let w = uniform_sphere([rng.uniform(), rng.uniform()]);
+            let q = equal_area_sphere_to_square(w);
+            assert!((0.0..=1.0).contains(&q[0]) && (0.0..=1.0).contains(&q[1]));
+            assert!(
+                (equal_area_square_to_sphere(q) - w).length() < 1e-9,
+                "{w:?}"
+            );
+        }
+        // Poles, equator and the lower pole at the corners.
+        assert!((equal_area_square_to_sphere([0.5, 0.5]) - Vec3::Z).length() < 1e-15);
+        for corner in [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]] {
+            assert!((equal_area_square_to_sphere(corner) + Vec3::Z).length() < 1e-15);
+        }
+        assert!((equal_area_square_to_sphere([1.0, 0.5]) - Vec3::X).length() < 1e-15);
+        assert!((equal_area_square_to_sphere([0.5, 1.0]) - Vec3::Y).length() < 1e-15);
+    }
+
+    #[test]
+    fn wrapping_continues_the_sphere() {
+        // A point just outside the square names the direction next to the one just inside:
+        // the map of the wrapped point is continuous across every edge.
+        let mut rng = Rng::new(SEED, 2);
+        let h = 1e-7;
+        for _ in 0..10_000 {
+            let t = rng.uniform();
+            for (inside, outside) in [
+                ([h, t], [-h, t]),
+                ([1.0 - h, t], [1.0 + h, t]),
+                ([t, h], [t, -h]),
+                ([t, 1.0 - h], [t, 1.0 + h]),
+            ] {
+                let a = equal_area_square_to_sphere(inside);
+                let b = equal_area_square_to_sphere(wrap_equal_area_square(outside));
+                assert!((a - b).length() < 1e-5, "{inside:?} vs {outside:?}");
+            }
+        }
+        // Texels: the one outside an edge is the mirror of the one inside.
+        let n = 8;
+        assert_eq!(wrap_equal_area_texel(-1, 2, n), (0, 5));
+        assert_eq!(wrap_equal_area_texel(8, 2, n), (7, 5));
+        assert_eq!(wrap_equal_area_texel(3, -1, n), (4, 0));
+        assert_eq!(wrap_equal_area_texel(3, 8, n), (4, 7));
+        assert_eq!(wrap_equal_area_texel(-1, -1, n), (7, 7));
+        assert_eq!(wrap_equal_area_texel(5, 6, n), (5, 6));
+        // The centre of texel −1 wraps to the centre of the texel the table names.
+        for (x, y) in [(-1i64, 2i64), (8, 2), (3, -1), (3, 8), (-1, -1), (8, 8)] {
+            let centre = |v: i64| (v as f64 + 0.5) / n as f64;
+            let wrapped = wrap_equal_area_square([centre(x), centre(y)]);
+            let (i, j) = wrap_equal_area_texel(x, y, n);
+            assert!(
+                (wrapped[0] - centre(i as i64)).abs() < 1e-12
+                    && (wrapped[1] - centre(j as i64)).abs() < 1e-12,
+                "({x}, {y}) → {wrapped:?} vs ({i}, {j})"
+            );
+        }
+    }
+
+    #[test]
+    fn equal_area_jacobian_is_four_pi() {
+        // |∂w/∂s × ∂w/∂t| by central differences, step 1e-6, is 4π to 1e-5 relative away
+        // from the creases (the diamond's sides and the axes), where the map is smooth.
+        let mut rng = Rng::new(SEED, 3);
+        let h = 1e-6;
+        let mut checked = 0;
+        while checked < 2_000 {
+            let p = [rng.uniform(), rng.uniform()];
+            let (a, b) = (2.0 * p[0] - 1.0, 2.0 * p[1] - 1.0);
+            if a.abs() < 1e-3 || b.abs() < 1e-3 || (a.abs() + b.abs() - 1.0).abs() < 1e-3 {
+                continue;
+            }
+            let d = |dp: [f64; 2]| {
+                let w0 = equal_area_square_to_sphere([p[0] - dp[0], p[1] - dp[1]]);
+                let w1 = equal_area_square_to_sphere([p[0] + dp[0], p[1] + dp[1]]);
+                (w1 - w0) / (2.0 * h)
+            };
+            let jacobian = d([h, 0.0]).cross(d([0.0, h])).length();
+            assert!(
+                (jacobian / (4.0 * PI) - 1.0).abs() < 1e-5,
+                "{p:?}: {jacobian}"
+            );
+            checked += 1;
+        }
+    }
+
+    #[test]
+    fn chi_square_equal_area_square_to_sphere() {
+        SphericalBins::about_z(-1.0, [20, 40])
+            .test(SAMPLES, SEED, equal_area_square_to_sphere, |_| SPHERE_PDF)
+            .assert_accepted("equal-area square to sphere");
+    }
+
+    #[test]
+    fn chi_square_equal_area_sphere_to_square() {
+        // Uniform directions land uniformly in the square: the Jacobian is 4π everywhere.
+        PlanarBins::square(0.0, 1.0, 32)
+            .test(
+                SAMPLES,
+                SEED,
+                |u| {
+                    let p = equal_area_sphere_to_square(uniform_sphere(u));
+                    (p[0], p[1])
+                },
+                |_, _| 1.0,
+            )
+            .assert_accepted("equal-area sphere to square");
+    }
+}
