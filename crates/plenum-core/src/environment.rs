@@ -434,7 +434,7 @@ mod tests {
         for _ in 0..100_000 {
             let (wi, _, _) = lat_long.sample([rng.uniform(), rng.uniform()]).unwrap();
             let theta = frame.to_local(wi).z.clamp(-1.0, 1.0).acos();
-            assert!(theta >= PI / 16.0 && theta <= PI * 15.0 / 16.0, "{theta}");
+            assert!((PI / 16.0..=PI * 15.0 / 16.0).contains(&theta), "{theta}");
         }
     }
 

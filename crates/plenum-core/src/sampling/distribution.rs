@@ -579,8 +579,8 @@ mod tests {
             from_bins[i] += b.keep / n;
             from_bins[b.alias] += (1.0 - b.keep) / n;
         }
-        for i in 0..table.len() {
-            assert!((from_bins[i] - table.pmf(i)).abs() < 1e-12, "index {i}");
+        for (i, p) in from_bins.iter().enumerate() {
+            assert!((p - table.pmf(i)).abs() < 1e-12, "index {i}");
         }
         let mut rng = Rng::new(SEED, 4);
         for _ in 0..100_000 {
