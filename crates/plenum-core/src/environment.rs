@@ -2,7 +2,7 @@
 //! image of linear RGB, looked up with bilinear filtering and importance-sampled in
 //! proportion to its luminance.
 //!
-//! Sampling follows pbrt-v4 §12.5.3 (the image infinite light): a [`PiecewiseConstant2D`]
+//! Sampling follows pbrt-v4 §12.5.2 (image infinite lights): a [`PiecewiseConstant2D`]
 //! over the image's parameter square picks a point, which the layout's map turns into a
 //! direction, and the density per unit area of the square becomes one per steradian by the
 //! map's Jacobian. Two layouts:
@@ -164,6 +164,16 @@ impl EnvironmentMap {
     /// The layout the map was built with.
     pub fn layout(&self) -> EnvironmentLayout {
         self.layout
+    }
+
+    /// The image's size in texels, [width, height].
+    pub fn resolution(&self) -> [usize; 2] {
+        [self.width, self.height]
+    }
+
+    /// The frame whose `to_world` carries the map's directions into the world.
+    pub fn frame(&self) -> Frame {
+        self.frame
     }
 
     /// The solid angle of a texel in row `j`, in steradians.
@@ -387,6 +397,31 @@ mod tests {
     }
 
     #[test]
+    fn chi_square_rejects_a_shifted_bright_texel() {
+        // Samples of the lat-long map against the pdf of the same map with its bright texel
+        // one column over: the test must be able to fail.
+        let mut shifted = lat_long_texels();
+        shifted.swap(6 * 32 + 9, 6 * 32 + 10);
+        let wrong = EnvironmentMap::new(
+            32,
+            16,
+            shifted,
+            EnvironmentLayout::LatLong,
+            tilted_frame(),
+            1.5,
+        )
+        .unwrap();
+        let map = &maps()[0];
+        let outcome = SphericalBins::about_z(-1.0, [20, 40]).test(
+            SAMPLES,
+            SEED,
+            |u| map.sample(u).map_or(Vec3::splat(f64::NAN), |(wi, _, _)| wi),
+            |w| wrong.pdf(w),
+        );
+        assert!(!outcome.accepted(), "{outcome:?}");
+    }
+
+    #[test]
     fn samples_agree_with_pdf_and_radiance() {
         for map in maps() {
             let mut rng = Rng::new(SEED, 1);
@@ -434,7 +469,7 @@ mod tests {
         for _ in 0..100_000 {
             let (wi, _, _) = lat_long.sample([rng.uniform(), rng.uniform()]).unwrap();
             let theta = frame.to_local(wi).z.clamp(-1.0, 1.0).acos();
-            assert!(theta >= PI / 16.0 && theta <= PI * 15.0 / 16.0, "{theta}");
+            assert!((PI / 16.0..=PI * 15.0 / 16.0).contains(&theta), "{theta}");
         }
     }
 

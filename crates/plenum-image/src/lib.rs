@@ -1,6 +1,12 @@
 //! Image files for Plenum. Renders leave as PNG (8-bit sRGB after exposure and clamping),
 //! OpenEXR (linear 32-bit float RGB), PFM (linear float, the Portable Float Map) or Radiance
-//! HDR; textures arrive from PNG or JPEG, decoded from sRGB to linear.
+//! HDR; textures arrive from PNG or JPEG, decoded from sRGB to linear; float images (for
+//! environment maps) arrive from EXR, HDR, PFM, PNG or JPEG through [`read_float_image`].
+//!
+//! PFM has no formal standard; this crate follows the description of its author's HDRShop
+//! (Debevec): a header "PF" (RGB) or "Pf" (grey), the width and height, and a scale whose sign
+//! gives the byte order (negative: little-endian) and whose magnitude multiplies the values,
+//! each followed by one white-space character; then 32-bit floats, rows from the bottom up.
 //!
 //! Pixels are linear RGB triples, row-major from the top-left, in the layout of
 //! `plenum_core::film::Film::pixels`; this crate does not depend on the renderer.
@@ -23,6 +29,16 @@ pub enum ImageError {
         path: String,
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+    #[error("{path}: byte offset {offset}: {message}")]
+    Malformed {
+        path: String,
+        offset: usize,
+        message: String,
+    },
+    #[error(
+        "unsupported image extension `{0}` to read: use .exr, .hdr, .pfm, .png, .jpg or .jpeg"
+    )]
+    UnsupportedReadExtension(String),
 }
 
 /// The output formats, chosen by file extension.
@@ -161,6 +177,185 @@ pub fn read_texture(path: &Path) -> Result<Texels, ImageError> {
     })
 }
 
+/// A float image of linear RGB, row-major from the top-left.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FloatImage {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<[f32; 3]>,
+}
+
+/// Reads a linear RGB float image, chosen by extension: `.exr` and `.hdr` (Radiance RGBE)
+/// through the `image` crate, `.pfm` by [`parse_pfm`], `.png`, `.jpg` and `.jpeg` as 8- or
+/// 16-bit sRGB decoded to linear. Alpha is dropped; grey images become grey RGB.
+pub fn read_float_image(path: &Path) -> Result<FloatImage, ImageError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    let read_error = |e: Box<dyn std::error::Error + Send + Sync>| ImageError::Read {
+        path: path.display().to_string(),
+        source: e,
+    };
+    let (linear, format) = match ext.as_str() {
+        "pfm" => {
+            let bytes = std::fs::read(path).map_err(|e| read_error(e.into()))?;
+            return parse_pfm(&bytes).map_err(|e| ImageError::Malformed {
+                path: path.display().to_string(),
+                offset: e.offset,
+                message: e.message,
+            });
+        }
+        "exr" => (true, ImageFormat::OpenExr),
+        "hdr" => (true, ImageFormat::Hdr),
+        "png" => (false, ImageFormat::Png),
+        "jpg" | "jpeg" => (false, ImageFormat::Jpeg),
+        _ => return Err(ImageError::UnsupportedReadExtension(ext)),
+    };
+    let file = std::fs::File::open(path).map_err(|e| read_error(e.into()))?;
+    let img = image::ImageReader::with_format(std::io::BufReader::new(file), format)
+        .decode()
+        .map_err(|e| read_error(e.into()))?;
+    let (width, height) = (img.width(), img.height());
+    let pixels = img
+        .to_rgb32f()
+        .pixels()
+        .map(|p| if linear { p.0 } else { p.0.map(srgb_decode) })
+        .collect();
+    Ok(FloatImage {
+        width,
+        height,
+        pixels,
+    })
+}
+
+/// What is wrong with a PFM file, and at which byte.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PfmError {
+    pub offset: usize,
+    pub message: String,
+}
+
+/// Decodes a PFM file held in memory (see the crate docs for the format). Never panics, and
+/// allocates the pixels only once the file is known to hold them all; bytes after the last
+/// row are ignored.
+pub fn parse_pfm(bytes: &[u8]) -> Result<FloatImage, PfmError> {
+    let fail = |offset: usize, message: String| Err(PfmError { offset, message });
+    let channels = match bytes.get(..2) {
+        Some(b"PF") => 3,
+        Some(b"Pf") => 1,
+        _ => return fail(0, "not a PFM file: it must begin with `PF` or `Pf`".into()),
+    };
+    let mut at = 2;
+    // Each header field is preceded by white space and read up to the next white space.
+    let mut field = |what: &str| -> Result<(usize, String), PfmError> {
+        let start = at;
+        while bytes.get(at).is_some_and(u8::is_ascii_whitespace) {
+            at += 1;
+        }
+        if at == start {
+            return Err(PfmError {
+                offset: at,
+                message: format!("expected white space before the {what}"),
+            });
+        }
+        let begin = at;
+        while bytes.get(at).is_some_and(|b| !b.is_ascii_whitespace()) && at - begin < 64 {
+            at += 1;
+        }
+        if at == begin {
+            return Err(PfmError {
+                offset: at,
+                message: format!("the header ends before the {what}"),
+            });
+        }
+        Ok((
+            begin,
+            String::from_utf8_lossy(&bytes[begin..at]).into_owned(),
+        ))
+    };
+    let mut dimension = |what: &str| -> Result<u32, PfmError> {
+        let (offset, text) = field(what)?;
+        match text.parse::<u32>() {
+            Ok(n) if n > 0 => Ok(n),
+            _ => Err(PfmError {
+                offset,
+                message: format!("the {what} `{text}` is not a whole number of at least 1"),
+            }),
+        }
+    };
+    let width = dimension("width")?;
+    let height = dimension("height")?;
+    let (offset, text) = field("scale")?;
+    let scale = match text.parse::<f32>() {
+        Ok(s) if s.is_finite() && s != 0.0 => s,
+        _ => {
+            return fail(
+                offset,
+                format!("the scale `{text}` is not a finite, non-zero number"),
+            )
+        }
+    };
+    // Exactly one white-space byte ends the header; the pixels may begin with any byte.
+    match bytes.get(at) {
+        Some(b) if b.is_ascii_whitespace() => at += 1,
+        _ => return fail(at, "expected one white-space byte after the scale".into()),
+    }
+    let available = bytes.len() - at;
+    // At most 2^64 · 12 bytes: u128 cannot overflow.
+    let needed = width as u128 * height as u128 * channels as u128 * 4;
+    if needed > available as u128 {
+        return fail(
+            bytes.len(),
+            format!(
+                "the pixels end early: {width} × {height} × {channels} floats need {needed} \
+                 bytes from offset {at}, the file holds {available}"
+            ),
+        );
+    }
+    let little_endian = scale < 0.0;
+    let magnitude = scale.abs();
+    let data = &bytes[at..at + needed as usize];
+    let value = |k: usize| {
+        let b = [
+            data[4 * k],
+            data[4 * k + 1],
+            data[4 * k + 2],
+            data[4 * k + 3],
+        ];
+        let v = if little_endian {
+            f32::from_le_bytes(b)
+        } else {
+            f32::from_be_bytes(b)
+        };
+        if magnitude == 1.0 {
+            v
+        } else {
+            v * magnitude
+        }
+    };
+    let (w, h) = (width as usize, height as usize);
+    let mut pixels = Vec::with_capacity(w * h);
+    for y in 0..h {
+        // The file's first row is the image's bottom one.
+        let row = h - 1 - y;
+        for x in 0..w {
+            let k = (row * w + x) * channels;
+            pixels.push(if channels == 3 {
+                [value(k), value(k + 1), value(k + 2)]
+            } else {
+                [value(k); 3]
+            });
+        }
+    }
+    Ok(FloatImage {
+        width,
+        height,
+        pixels,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -200,5 +395,170 @@ mod tests {
             Err(ImageError::UnsupportedExtension(_))
         ));
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    fn temp_dir(name: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("plenum-image-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// A 3 × 2 image with a distinct value in every channel of every pixel.
+    fn test_pixels() -> Vec<[f32; 3]> {
+        (0..6)
+            .map(|i| {
+                let i = i as f32;
+                [0.1 + 0.1 * i, 0.05 * i, 0.9 - 0.1 * i]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn float_formats_round_trip() {
+        let dir = temp_dir("round-trip");
+        let mut pixels = test_pixels();
+        // Values above 1 survive the float formats.
+        pixels[4] = [12.5, 0.25, 3.0];
+        for (ext, tolerance) in [("exr", 0.0), ("pfm", 0.0), ("hdr", 1.0 / 64.0)] {
+            let path = dir.join(format!("t.{ext}"));
+            write_image(&path, 3, 2, &pixels, 0.0).unwrap();
+            let back = read_float_image(&path).unwrap();
+            assert_eq!((back.width, back.height), (3, 2), "{ext}");
+            for (a, b) in pixels.iter().zip(&back.pixels) {
+                for c in 0..3 {
+                    // RGBE shares one exponent per pixel: error relative to the largest channel.
+                    let largest = a.iter().fold(0.0f32, |m, &v| m.max(v));
+                    assert!(
+                        (a[c] - b[c]).abs() <= tolerance * largest,
+                        "{ext}: {a:?} vs {b:?}"
+                    );
+                }
+            }
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn eight_bit_formats_decode_to_linear() {
+        let dir = temp_dir("srgb");
+        let pixels = test_pixels();
+        let path = dir.join("t.png");
+        write_image(&path, 3, 2, &pixels, 0.0).unwrap();
+        let back = read_float_image(&path).unwrap();
+        assert_eq!((back.width, back.height), (3, 2));
+        for (a, b) in pixels.iter().zip(&back.pixels) {
+            for c in 0..3 {
+                // One 8-bit step of the encoded value, in linear terms, is below 0.01 here.
+                assert!((a[c] - b[c]).abs() < 0.005, "png: {a:?} vs {b:?}");
+            }
+        }
+        // A flat JPEG of encoded grey 128 decodes to linear 0.216.
+        let jpeg = dir.join("t.jpg");
+        image::RgbImage::from_pixel(8, 8, image::Rgb([128, 128, 128]))
+            .save_with_format(&jpeg, ImageFormat::Jpeg)
+            .unwrap();
+        let back = read_float_image(&jpeg).unwrap();
+        assert_eq!((back.width, back.height), (8, 8));
+        for p in &back.pixels {
+            assert!(
+                p.iter()
+                    .all(|&v| (v - srgb_decode(128.0 / 255.0)).abs() < 0.01),
+                "{p:?}"
+            );
+        }
+        assert!(matches!(
+            read_float_image(&dir.join("t.bmp")),
+            Err(ImageError::UnsupportedReadExtension(_))
+        ));
+        assert!(matches!(
+            read_float_image(&dir.join("missing.exr")),
+            Err(ImageError::Read { .. })
+        ));
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// A PFM file from its header and float values, in the given byte order.
+    fn pfm(header: &str, values: &[f32], little_endian: bool) -> Vec<u8> {
+        let mut bytes = header.as_bytes().to_vec();
+        for v in values {
+            bytes.extend(if little_endian {
+                v.to_le_bytes()
+            } else {
+                v.to_be_bytes()
+            });
+        }
+        bytes
+    }
+
+    #[test]
+    fn pfm_byte_order_scale_grey_and_row_order() {
+        // Big-endian (positive scale), two rows: the file's first row is the bottom one.
+        let values = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let image = parse_pfm(&pfm("PF\n1 2\n1.0\n", &values, false)).unwrap();
+        assert_eq!(image.pixels, vec![[4.0, 5.0, 6.0], [1.0, 2.0, 3.0]]);
+        // Grey, little-endian, scale magnitude 2 multiplies; any white space between fields.
+        let image = parse_pfm(&pfm("Pf  2\t1 -2.0 ", &[0.5, 1.5], true)).unwrap();
+        assert_eq!((image.width, image.height), (2, 1));
+        assert_eq!(image.pixels, vec![[1.0; 3], [3.0; 3]]);
+        // Trailing bytes after the last row are ignored.
+        let mut bytes = pfm("PF\n1 1\n-1\n", &[7.0, 8.0, 9.0], true);
+        bytes.extend(b"junk");
+        assert_eq!(parse_pfm(&bytes).unwrap().pixels, vec![[7.0, 8.0, 9.0]]);
+    }
+
+    #[test]
+    fn pfm_truncated_and_malformed_files_are_errors() {
+        let whole = pfm("PF\n2 2\n-1.0\n", &[0.5; 12], true);
+        let header_length = "PF\n2 2\n-1.0\n".len();
+        for end in 0..whole.len() {
+            let error = parse_pfm(&whole[..end]).expect_err("a truncated file is an error");
+            if end >= header_length {
+                assert_eq!(error.offset, end, "{error:?}");
+                assert!(error.message.contains("end early"), "{error:?}");
+            }
+        }
+        let cases: [(&[u8], usize); 12] = [
+            (b"P6\n1 1\n255\n", 0),
+            (b"", 0),
+            (b"PF", 2),
+            (b"PF1 1 -1\n", 2),
+            (b"PF\nx 1\n-1\n", 3),
+            (b"PF\n0 1\n-1\n", 3),
+            (b"PF\n1 -1\n-1\n", 5),
+            (b"PF\n99999999999 1\n-1\n", 3),
+            (b"PF\n1 1\n0\n", 7),
+            (b"PF\n1 1\nnan\n", 7),
+            (b"PF\n1 1\n-1", 9),
+            (b"PF\n4294967295 4294967295\n-1\n", 28),
+        ];
+        for (bytes, offset) in cases {
+            let error = parse_pfm(bytes).expect_err("malformed");
+            assert_eq!(
+                error.offset,
+                offset,
+                "{:?}: {error:?}",
+                String::from_utf8_lossy(bytes)
+            );
+        }
+        // Through the file reader the offset is part of the message.
+        let dir = temp_dir("pfm");
+        let path = dir.join("short.pfm");
+        std::fs::write(&path, &whole[..20]).unwrap();
+        let message = read_float_image(&path).unwrap_err().to_string();
+        assert!(message.contains("byte offset 20"), "{message}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn pfm_parser_never_panics_on_corrupted_bytes() {
+        // Every single-byte corruption of a small file, to each of a few telling values.
+        let whole = pfm("PF\n2 1\n-1.0\n", &[0.25; 6], true);
+        for k in 0..whole.len() {
+            for replacement in [b' ', b'\n', b'0', b'9', b'-', b'P', b'f', 0, 0xFF] {
+                let mut bytes = whole.clone();
+                bytes[k] = replacement;
+                let _ = parse_pfm(&bytes);
+            }
+        }
     }
 }

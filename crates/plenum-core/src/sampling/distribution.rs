@@ -1,9 +1,9 @@
 //! Sampling tabulated functions: piecewise-constant densities in one and two dimensions by
 //! inversion of their cumulative distribution, and discrete distributions by the alias method.
 //!
-//! The piecewise-constant distributions follow pbrt-v4 §A.4 (Pharr, Jakob & Humphreys 2023):
-//! a 2-D density is a marginal over rows times a conditional within the chosen row, each
-//! sampled by inverting its cumulative distribution. The alias table is Walker's method
+//! The piecewise-constant distributions follow pbrt-v4, Appendix A (Pharr, Jakob & Humphreys
+//! 2023): a 2-D density is a marginal over rows times a conditional within the chosen row,
+//! each sampled by inverting its cumulative distribution. The alias table is Walker's method
 //! (Walker 1977, "An efficient method for generating discrete random variables with general
 //! distributions") built in O(n) by Vose's construction (Vose 1991, "A linear algorithm for
 //! generating random numbers with a given distribution").
@@ -579,8 +579,8 @@ mod tests {
             from_bins[i] += b.keep / n;
             from_bins[b.alias] += (1.0 - b.keep) / n;
         }
-        for i in 0..table.len() {
-            assert!((from_bins[i] - table.pmf(i)).abs() < 1e-12, "index {i}");
+        for (i, p) in from_bins.iter().enumerate() {
+            assert!((p - table.pmf(i)).abs() < 1e-12, "index {i}");
         }
         let mut rng = Rng::new(SEED, 4);
         for _ in 0..100_000 {
