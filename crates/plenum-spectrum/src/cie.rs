@@ -52,7 +52,10 @@ mod tests {
     #[test]
     fn y_samples_sum_to_the_integral() {
         let sum: f64 = CIE_Y.iter().sum();
-        assert!((sum - CIE_Y_INTEGRAL).abs() / CIE_Y_INTEGRAL < 1e-5, "{sum}");
+        assert!(
+            (sum - CIE_Y_INTEGRAL).abs() / CIE_Y_INTEGRAL < 1e-5,
+            "{sum}"
+        );
     }
 
     #[test]

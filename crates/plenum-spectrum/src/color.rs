@@ -56,7 +56,11 @@ pub fn xyz_to_lab(xyz: [f64; 3], white: [f64; 3]) -> [f64; 3] {
             t / (3.0 * D * D) + 4.0 / 29.0
         }
     };
-    let (fx, fy, fz) = (f(xyz[0] / white[0]), f(xyz[1] / white[1]), f(xyz[2] / white[2]));
+    let (fx, fy, fz) = (
+        f(xyz[0] / white[0]),
+        f(xyz[1] / white[1]),
+        f(xyz[2] / white[2]),
+    );
     [116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz)]
 }
 
@@ -122,7 +126,10 @@ mod tests {
     #[test]
     fn rgb_mode_passes_lanes_through() {
         let s = SampledSpectrum([0.25, 0.5, 2.0, 0.0]);
-        assert_eq!(s.to_linear_srgb(&SampledWavelengths::rgb()), [0.25, 0.5, 2.0]);
+        assert_eq!(
+            s.to_linear_srgb(&SampledWavelengths::rgb()),
+            [0.25, 0.5, 2.0]
+        );
     }
 
     #[test]

@@ -31,15 +31,29 @@ const SF2: Spectrum = Spectrum::Sellmeier {
 /// fused silica", J. Opt. Soc. Am. 55, 1205 (valid 0.21–3.71 µm); n_D = 1.4585.
 const FUSED_SILICA: Spectrum = Spectrum::Sellmeier {
     b: [0.6961663, 0.4079426, 0.8974794],
-    c: [0.0684043 * 0.0684043, 0.1162414 * 0.1162414, 9.896161 * 9.896161],
+    c: [
+        0.0684043 * 0.0684043,
+        0.1162414 * 0.1162414,
+        9.896161 * 9.896161,
+    ],
 };
 
 /// Water at 20 °C after Daimon and Masumura 2007, "Measurement of the refractive index of
 /// distilled water from the near-infrared region to the ultraviolet region", Appl. Opt. 46,
 /// 3811 (four-term Sellmeier fit, 0.182–1.129 µm); n_D = 1.3330.
 const WATER: Spectrum = Spectrum::Sellmeier4 {
-    b: [5.684027565e-1, 1.726177391e-1, 2.086189578e-2, 1.130748688e-1],
-    c: [5.101829712e-3, 1.821153936e-2, 2.620722293e-2, 1.069792721e1],
+    b: [
+        5.684027565e-1,
+        1.726177391e-1,
+        2.086189578e-2,
+        1.130748688e-1,
+    ],
+    c: [
+        5.101829712e-3,
+        1.821153936e-2,
+        2.620722293e-2,
+        1.069792721e1,
+    ],
 };
 
 /// Diamond after Peter 1923, "Über Brechungsindizes und Absorptionskonstanten des Diamanten
@@ -57,8 +71,11 @@ fn table(pairs: &[(f64, f64)]) -> Spectrum {
 /// A CIE illuminant table as an emission spectrum scaled to unit luminance (pbrt-v4 does
 /// the same with its `stdillum-*` spectra).
 fn illuminant(values: &[f64], start: f64) -> Spectrum {
-    let pairs: Vec<(f64, f64)> =
-        values.iter().enumerate().map(|(i, &v)| (start + 5.0 * i as f64, v)).collect();
+    let pairs: Vec<(f64, f64)> = values
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| (start + 5.0 * i as f64, v))
+        .collect();
     let raw = Spectrum::piecewise_illuminant(&pairs).expect("built-in table is valid");
     let y = {
         // Luminance of the table as given, through the same integral as illuminant_to_rgb.
@@ -92,8 +109,18 @@ fn all() -> &'static [(&'static str, Spectrum)] {
             (&il::ILLUM_F12, il::ILLUM_F12_START),
         ];
         const F_NAMES: [&str; 12] = [
-            "stdillum-F1", "stdillum-F2", "stdillum-F3", "stdillum-F4", "stdillum-F5", "stdillum-F6",
-            "stdillum-F7", "stdillum-F8", "stdillum-F9", "stdillum-F10", "stdillum-F11", "stdillum-F12",
+            "stdillum-F1",
+            "stdillum-F2",
+            "stdillum-F3",
+            "stdillum-F4",
+            "stdillum-F5",
+            "stdillum-F6",
+            "stdillum-F7",
+            "stdillum-F8",
+            "stdillum-F9",
+            "stdillum-F10",
+            "stdillum-F11",
+            "stdillum-F12",
         ];
         let mut v: Vec<(&'static str, Spectrum)> = vec![
             ("metal-Ag-eta", table(&metals::AG_ETA)),
@@ -116,8 +143,14 @@ fn all() -> &'static [(&'static str, Spectrum)] {
             ("glass-SF2", SF2),
             ("glass-fused-silica", FUSED_SILICA),
             ("stdillum-A", illuminant(&il::ILLUM_A, il::ILLUM_A_START)),
-            ("stdillum-D50", illuminant(&il::ILLUM_D50, il::ILLUM_D50_START)),
-            ("stdillum-D65", illuminant(&il::ILLUM_D65, il::ILLUM_D65_START)),
+            (
+                "stdillum-D50",
+                illuminant(&il::ILLUM_D50, il::ILLUM_D50_START),
+            ),
+            (
+                "stdillum-D65",
+                illuminant(&il::ILLUM_D65, il::ILLUM_D65_START),
+            ),
         ];
         for (name, (vals, start)) in F_NAMES.iter().zip(f) {
             v.push((name, illuminant(vals, start)));
@@ -139,7 +172,10 @@ fn all() -> &'static [(&'static str, Spectrum)] {
 /// and refractive indices are dimensionless; `stdillum-*` are emission spectra of unit
 /// luminance (Y = 1).
 pub fn named(name: &str) -> Option<Spectrum> {
-    all().iter().find(|(n, _)| *n == name).map(|(_, s)| s.clone())
+    all()
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, s)| s.clone())
 }
 
 /// Every name [`named`] knows.
@@ -197,7 +233,14 @@ mod tests {
         assert!((n("glass-BK7", 586.0) - 1.516865556749).abs() < 1e-5);
         assert!((n("glass-BAF10", 586.0) - 1.6701073530462).abs() < 1e-4);
         // Normal dispersion: blue bends more.
-        for m in ["water", "crown-glass", "dense-flint", "diamond", "glass-F5", "glass-F11"] {
+        for m in [
+            "water",
+            "crown-glass",
+            "dense-flint",
+            "diamond",
+            "glass-F5",
+            "glass-F11",
+        ] {
             assert!(n(m, 450.0) > n(m, 650.0), "{m}");
         }
     }
@@ -237,7 +280,11 @@ mod tests {
         for (m, r) in published {
             for (i, l) in [450.0, 550.0, 650.0].into_iter().enumerate() {
                 let v = reflectance(m, l);
-                assert!((v - r[i]).abs() < 0.03, "{m} at {l}: {v} (published {})", r[i]);
+                assert!(
+                    (v - r[i]).abs() < 0.03,
+                    "{m} at {l}: {v} (published {})",
+                    r[i]
+                );
             }
         }
         assert!(reflectance("Au", 650.0) > reflectance("Au", 450.0));

@@ -290,7 +290,9 @@ mod tests {
     fn visible_pdf_integrates_to_one() {
         let n = 47_000;
         let h = (LAMBDA_MAX - LAMBDA_MIN) / n as f64;
-        let sum: f64 = (0..n).map(|i| visible_pdf(LAMBDA_MIN + (i as f64 + 0.5) * h) * h).sum();
+        let sum: f64 = (0..n)
+            .map(|i| visible_pdf(LAMBDA_MIN + (i as f64 + 0.5) * h) * h)
+            .sum();
         assert!((sum - 1.0).abs() < 1e-4, "{sum}");
         assert_eq!(visible_pdf(359.0), 0.0);
         assert_eq!(visible_pdf(831.0), 0.0);
@@ -300,9 +302,9 @@ mod tests {
     fn sample_visible_stratifies_lanes() {
         let wl = SampledWavelengths::sample_visible(0.8);
         let expect = [0.8, 0.05, 0.3, 0.55].map(sample_visible_wavelength);
-        for i in 0..N_SAMPLES {
-            assert!((wl.lambda()[i] - expect[i]).abs() < 1e-9);
-            assert_eq!(wl.pdf()[i], visible_pdf(expect[i]));
+        for (i, &e) in expect.iter().enumerate() {
+            assert!((wl.lambda()[i] - e).abs() < 1e-9);
+            assert_eq!(wl.pdf()[i], visible_pdf(e));
             assert!((LAMBDA_MIN..=LAMBDA_MAX).contains(&wl.lambda()[i]));
         }
         assert!(!wl.is_rgb());
@@ -313,7 +315,8 @@ mod tests {
         // d λ / d u = 1 / pdf(λ).
         for u in [0.05, 0.3, 0.6, 0.95] {
             let h = 1e-6;
-            let dl = (sample_visible_wavelength(u + h) - sample_visible_wavelength(u - h)) / (2.0 * h);
+            let dl =
+                (sample_visible_wavelength(u + h) - sample_visible_wavelength(u - h)) / (2.0 * h);
             let p = visible_pdf(sample_visible_wavelength(u));
             assert!((dl * p - 1.0).abs() < 1e-4, "{u}: {}", dl * p);
         }

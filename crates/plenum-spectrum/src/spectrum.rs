@@ -116,11 +116,19 @@ pub enum Spectrum {
     RgbAlbedo { rgb: [f64; 3], sigmoid: RgbSigmoid },
     /// An unbounded positive quantity from `rgb`: `scale` · sigmoid(λ) with scale = 2 · max
     /// component and the sigmoid fitted to rgb / scale (pbrt-v4's `RGBUnboundedSpectrum`).
-    RgbUnbounded { rgb: [f64; 3], scale: f64, sigmoid: RgbSigmoid },
+    RgbUnbounded {
+        rgb: [f64; 3],
+        scale: f64,
+        sigmoid: RgbSigmoid,
+    },
     /// Emission from `rgb`: the unbounded form times D65 of unit luminance
     /// ([`d65_normalized`]), so seen directly it converts back to `rgb` (pbrt-v4's
     /// `RGBIlluminantSpectrum`).
-    RgbIlluminant { rgb: [f64; 3], scale: f64, sigmoid: RgbSigmoid },
+    RgbIlluminant {
+        rgb: [f64; 3],
+        scale: f64,
+        sigmoid: RgbSigmoid,
+    },
     /// Sellmeier's dispersion formula n(λ) = √(1 + Σ Bᵢ λ² / (λ² − Cᵢ)), λ in µm, C in µm².
     Sellmeier { b: [f64; 3], c: [f64; 3] },
     /// The four-term Sellmeier formula (Daimon and Masumura's form for water), λ in µm.
@@ -154,7 +162,9 @@ impl Spectrum {
         }
         for (i, &(l, v)) in pairs.iter().enumerate() {
             if !l.is_finite() || !v.is_finite() {
-                return Err(format!("piecewise-linear spectrum: pair {i} ({l}, {v}) is not finite"));
+                return Err(format!(
+                    "piecewise-linear spectrum: pair {i} ({l}, {v}) is not finite"
+                ));
             }
             if i > 0 && l <= pairs[i - 1].0 {
                 return Err(format!(
@@ -179,21 +189,32 @@ impl Spectrum {
     /// A reflectance from linear sRGB (clamped to [0, 1]), by the shared sRGB table.
     pub fn rgb_albedo(rgb: [f64; 3]) -> Spectrum {
         let rgb = rgb.map(|v| v.clamp(0.0, 1.0));
-        Spectrum::RgbAlbedo { rgb, sigmoid: RgbToSpectrumTable::srgb().lookup(rgb) }
+        Spectrum::RgbAlbedo {
+            rgb,
+            sigmoid: RgbToSpectrumTable::srgb().lookup(rgb),
+        }
     }
 
     /// An unbounded spectrum from linear sRGB (negative components clamped to 0).
     pub fn rgb_unbounded(rgb: [f64; 3]) -> Spectrum {
         let rgb = rgb.map(|v| v.max(0.0));
         let (scale, sigmoid) = unbounded_fit(rgb);
-        Spectrum::RgbUnbounded { rgb, scale, sigmoid }
+        Spectrum::RgbUnbounded {
+            rgb,
+            scale,
+            sigmoid,
+        }
     }
 
     /// An emission spectrum from linear sRGB radiance (negative components clamped to 0).
     pub fn rgb_illuminant(rgb: [f64; 3]) -> Spectrum {
         let rgb = rgb.map(|v| v.max(0.0));
         let (scale, sigmoid) = unbounded_fit(rgb);
-        Spectrum::RgbIlluminant { rgb, scale, sigmoid }
+        Spectrum::RgbIlluminant {
+            rgb,
+            scale,
+            sigmoid,
+        }
     }
 
     /// The value at `lambda_nm` (units of the quantity: reflectance, radiance relative to the
@@ -202,7 +223,9 @@ impl Spectrum {
         match self {
             Spectrum::Constant(c) => *c,
             Spectrum::PiecewiseLinear(p) => p.eval(lambda_nm),
-            Spectrum::Blackbody { kelvin, scale } => scale * normalized_blackbody(lambda_nm, *kelvin),
+            Spectrum::Blackbody { kelvin, scale } => {
+                scale * normalized_blackbody(lambda_nm, *kelvin)
+            }
             Spectrum::RgbAlbedo { sigmoid, .. } => sigmoid.eval(lambda_nm),
             Spectrum::RgbUnbounded { scale, sigmoid, .. } => scale * sigmoid.eval(lambda_nm),
             Spectrum::RgbIlluminant { scale, sigmoid, .. } => {
@@ -236,7 +259,10 @@ impl Spectrum {
     pub fn is_dispersion_formula(&self) -> bool {
         matches!(
             self,
-            Spectrum::Sellmeier { .. } | Spectrum::Sellmeier4 { .. } | Spectrum::Cauchy { .. } | Spectrum::CiddorAir
+            Spectrum::Sellmeier { .. }
+                | Spectrum::Sellmeier4 { .. }
+                | Spectrum::Cauchy { .. }
+                | Spectrum::CiddorAir
         )
     }
 
@@ -340,7 +366,9 @@ impl Spectrum {
     pub fn max_value(&self) -> f64 {
         match self {
             Spectrum::Constant(c) => *c,
-            Spectrum::PiecewiseLinear(p) => p.value.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            Spectrum::PiecewiseLinear(p) => {
+                p.value.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+            }
             Spectrum::Blackbody { scale, .. } => *scale,
             Spectrum::RgbAlbedo { sigmoid, .. } => sigmoid.max_value(),
             Spectrum::RgbUnbounded { scale, sigmoid, .. } => scale * sigmoid.max_value(),
@@ -369,7 +397,10 @@ fn unbounded_fit(rgb: [f64; 3]) -> (f64, RgbSigmoid) {
     let m = rgb[0].max(rgb[1]).max(rgb[2]);
     let scale = 2.0 * m;
     if scale > 0.0 {
-        (scale, RgbToSpectrumTable::srgb().lookup(rgb.map(|v| v / scale)))
+        (
+            scale,
+            RgbToSpectrumTable::srgb().lookup(rgb.map(|v| v / scale)),
+        )
     } else {
         (0.0, RgbSigmoid::constant(0.0))
     }
@@ -402,8 +433,15 @@ mod tests {
     fn constant_one_projects_to_white() {
         let one = Spectrum::piecewise(&[(300.0, 1.0), (900.0, 1.0)]).unwrap();
         assert!(one.is_constant());
-        assert!(close3(one.to_rgb_reflectance(), [1.0; 3], 1e-3), "{:?}", one.to_rgb_reflectance());
-        assert_eq!(Spectrum::Constant(0.5).sample(&SampledWavelengths::rgb()).0, [0.5, 0.5, 0.5, 0.0]);
+        assert!(
+            close3(one.to_rgb_reflectance(), [1.0; 3], 1e-3),
+            "{:?}",
+            one.to_rgb_reflectance()
+        );
+        assert_eq!(
+            Spectrum::Constant(0.5).sample(&SampledWavelengths::rgb()).0,
+            [0.5, 0.5, 0.5, 0.0]
+        );
     }
 
     #[test]
@@ -431,7 +469,13 @@ mod tests {
 
     #[test]
     fn illuminant_round_trips() {
-        for rgb in [[17.0, 12.0, 4.0], [1.0, 0.0, 0.0], [0.2, 0.5, 0.9], [3.0, 3.0, 3.0], [0.05, 0.3, 0.01]] {
+        for rgb in [
+            [17.0, 12.0, 4.0],
+            [1.0, 0.0, 0.0],
+            [0.2, 0.5, 0.9],
+            [3.0, 3.0, 3.0],
+            [0.05, 0.3, 0.01],
+        ] {
             let s = Spectrum::rgb_illuminant(rgb);
             let back = reflectance_free_integral(&s);
             let m = rgb.iter().copied().fold(0.0, f64::max);
@@ -448,7 +492,10 @@ mod tests {
             let s = Spectrum::rgb_unbounded(rgb);
             let back = reflectance_to_rgb(|l| s.eval(l));
             for i in 0..3 {
-                assert!((back[i] - rgb[i]).abs() < 0.01 * rgb[0].max(rgb[1]).max(rgb[2]), "{rgb:?} → {back:?}");
+                assert!(
+                    (back[i] - rgb[i]).abs() < 0.01 * rgb[0].max(rgb[1]).max(rgb[2]),
+                    "{rgb:?} → {back:?}"
+                );
             }
         }
     }
@@ -458,7 +505,10 @@ mod tests {
         let wl = SampledWavelengths::rgb();
         let a = Spectrum::rgb_albedo([0.2, 0.4, 0.6]);
         assert_eq!(a.sample(&wl).0, [0.2, 0.4, 0.6, 0.0]);
-        let glass = Spectrum::Sellmeier { b: [1.0, 0.0, 0.0], c: [0.01, 0.0, 0.0] };
+        let glass = Spectrum::Sellmeier {
+            b: [1.0, 0.0, 0.0],
+            c: [0.01, 0.0, 0.0],
+        };
         let s = glass.sample(&wl);
         assert_eq!(s[0], glass.eval(589.3));
         assert_eq!(s[3], 0.0);
@@ -469,7 +519,10 @@ mod tests {
             assert!((p[i] - q[i]).abs() < 1e-12);
         }
         // A 6500 K blackbody is nearly white; blue and red within 15 % of green.
-        assert!((p[0] / p[1] - 1.0).abs() < 0.15 && (p[2] / p[1] - 1.0).abs() < 0.15, "{p:?}");
+        assert!(
+            (p[0] / p[1] - 1.0).abs() < 0.15 && (p[2] / p[1] - 1.0).abs() < 0.15,
+            "{p:?}"
+        );
     }
 
     #[test]
@@ -488,7 +541,9 @@ mod tests {
         let s = Spectrum::piecewise(&[(400.0, 1.0), (500.0, 3.0)]).unwrap();
         let t = s.clone();
         match (&s, &t) {
-            (Spectrum::PiecewiseLinear(a), Spectrum::PiecewiseLinear(b)) => assert!(Arc::ptr_eq(a, b)),
+            (Spectrum::PiecewiseLinear(a), Spectrum::PiecewiseLinear(b)) => {
+                assert!(Arc::ptr_eq(a, b))
+            }
             _ => unreachable!(),
         }
     }
