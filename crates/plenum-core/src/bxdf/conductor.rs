@@ -98,9 +98,7 @@ impl ConductorBxdf {
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3, _mode: TransportMode, which: SampleFlags) -> f64 {
-        if !which.reflection()
-            || !same_hemisphere(wo, wi)
-            || self.distribution.effectively_smooth()
+        if !which.reflection() || !same_hemisphere(wo, wi) || self.distribution.effectively_smooth()
         {
             return 0.0;
         }
@@ -163,9 +161,19 @@ mod tests {
         ));
         let wo = Vec3::new(0.5, 0.1, 0.7).normalized();
         let s = b
-            .sample_f(wo, 0.5, [0.5, 0.5], TransportMode::Radiance, SampleFlags::All)
+            .sample_f(
+                wo,
+                0.5,
+                [0.5, 0.5],
+                TransportMode::Radiance,
+                SampleFlags::All,
+            )
             .unwrap();
-        let f = fr_complex(wo.z, SampledSpectrum::splat(2.0), SampledSpectrum::splat(4.0));
+        let f = fr_complex(
+            wo.z,
+            SampledSpectrum::splat(2.0),
+            SampledSpectrum::splat(4.0),
+        );
         assert!(s.is_specular());
         assert!((s.f[0] * s.wi.z / s.pdf - f[0]).abs() < 1e-14);
         assert!((s.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-15);
@@ -190,8 +198,8 @@ mod tests {
                 };
                 let wm = direction_at(theta_m.to_degrees(), 0.0);
                 let wi = direction_at((2.0 * theta_m).to_degrees(), 0.0);
-                let integrand = tr.d(wm) * wm.z * theta_m.sin() * std::f64::consts::TAU
-                    / (1.0 + tr.lambda(wi));
+                let integrand =
+                    tr.d(wm) * wm.z * theta_m.sin() * std::f64::consts::TAU / (1.0 + tr.lambda(wi));
                 weight * integrand
             })
             .sum::<f64>()
@@ -210,7 +218,9 @@ mod tests {
             let a = albedo_by_sampling(&perfect(alpha), Vec3::Z, TransportMode::Radiance, 200_000)
                 .average();
             let q = normal_incidence_albedo(alpha);
-            eprintln!("conductor F = 1, α = {alpha}, normal incidence: albedo {a:.4}, quadrature {q:.4}");
+            eprintln!(
+                "conductor F = 1, α = {alpha}, normal incidence: albedo {a:.4}, quadrature {q:.4}"
+            );
             assert!((a / q - 1.0).abs() < 0.01, "α {alpha}: {a} vs {q}");
         }
         // At 80°, bounds around the measured values: α 0.1: 0.895; α 0.5: 0.805.

@@ -27,8 +27,7 @@ use plenum_spectrum::SampledSpectrum;
 
 use super::fresnel::fr_dielectric;
 use super::{
-    same_hemisphere, BsdfSample, BxdfFlags, DielectricBxdf, DiffuseBxdf, SampleFlags,
-    TransportMode,
+    same_hemisphere, BsdfSample, BxdfFlags, DielectricBxdf, DiffuseBxdf, SampleFlags, TransportMode,
 };
 use crate::math::Vec3;
 use crate::sampling::{Frame, Rng};
@@ -174,12 +173,10 @@ impl CoatedDiffuseBxdf {
         let entry_pdf = |w: Vec3| top.pdf(wi, -w, adjoint(mode), transmission);
         for _ in 0..samples {
             // Into the layers along wo, and the virtual light's way in along wi.
-            let Some(wos) = usable(top.sample_f(wo, r(), [r(), r()], mode, transmission))
-            else {
+            let Some(wos) = usable(top.sample_f(wo, r(), [r(), r()], mode, transmission)) else {
                 continue;
             };
-            let Some(wis) =
-                usable(top.sample_f(wi, r(), [r(), r()], adjoint(mode), transmission))
+            let Some(wis) = usable(top.sample_f(wi, r(), [r(), r()], adjoint(mode), transmission))
             else {
                 continue;
             };
@@ -216,8 +213,7 @@ impl CoatedDiffuseBxdf {
                         f += beta
                             * self.albedo
                             * wis.f
-                            * (phase * weight * transmittance(zp - thickness, wis.wi)
-                                / wis.pdf);
+                            * (phase * weight * transmittance(zp - thickness, wis.wi) / wis.pdf);
                         let (wn, phase_pdf) = sample_henyey_greenstein(-w, self.g, [r(), r()]);
                         if phase_pdf == 0.0 || wn.z == 0.0 {
                             continue;
@@ -229,7 +225,7 @@ impl CoatedDiffuseBxdf {
                         if w.z > 0.0 && !top_specular {
                             let exit = top.f(-w, wi, mode);
                             if !exit.is_black() {
-                                    let weight = power_heuristic(phase_pdf, entry_pdf(w));
+                                let weight = power_heuristic(phase_pdf, entry_pdf(w));
                                 f += beta * exit * (transmittance(zp - thickness, w) * weight);
                             }
                         }
@@ -239,13 +235,9 @@ impl CoatedDiffuseBxdf {
                 }
                 if z == thickness {
                     // Back down off the underside of the coat.
-                    let Some(bs) = usable(top.sample_f(
-                        -w,
-                        r(),
-                        [r(), r()],
-                        mode,
-                        SampleFlags::Reflection,
-                    )) else {
+                    let Some(bs) =
+                        usable(top.sample_f(-w, r(), [r(), r()], mode, SampleFlags::Reflection))
+                    else {
                         break;
                     };
                     beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
@@ -255,16 +247,12 @@ impl CoatedDiffuseBxdf {
                     let weight = if top_specular {
                         1.0
                     } else {
-                        power_heuristic(
-                            wis.pdf,
-                            bottom.pdf(-w, -wis.wi, mode, SampleFlags::All),
-                        )
+                        power_heuristic(wis.pdf, bottom.pdf(-w, -wis.wi, mode, SampleFlags::All))
                     };
                     f += beta
                         * bottom.f(-w, -wis.wi, mode)
                         * wis.f
-                        * (wis.wi.z.abs() * weight * transmittance(thickness, wis.wi)
-                            / wis.pdf);
+                        * (wis.wi.z.abs() * weight * transmittance(thickness, wis.wi) / wis.pdf);
                     let Some(bs) =
                         usable(bottom.sample_f(-w, r(), [r(), r()], mode, SampleFlags::All))
                     else {
@@ -464,7 +452,10 @@ mod tests {
                 }
                 let integral = sum / n as f64;
                 eprintln!("coated diffuse α {alpha} wo {wo:?}: ∫ pdf = {integral:.4}");
-                assert!((integral - 1.0).abs() < 0.02, "α {alpha} {wo:?}: {integral}");
+                assert!(
+                    (integral - 1.0).abs() < 0.02,
+                    "α {alpha} {wo:?}: {integral}"
+                );
             }
         }
     }
@@ -476,7 +467,11 @@ mod tests {
         // different walks, so this checks both are unbiased estimates of the same BSDF.
         for (alpha, base, albedo) in [(0.0, 0.8, 0.0), (0.3, 0.8, 0.0), (0.3, 0.5, 0.9)] {
             let b = coated(alpha, base, albedo);
-            for wo in [direction_at(20.0, 0.1), direction_at(70.0, 2.0), -direction_at(45.0, 1.0)] {
+            for wo in [
+                direction_at(20.0, 0.1),
+                direction_at(70.0, 2.0),
+                -direction_at(45.0, 1.0),
+            ] {
                 let mode = TransportMode::Radiance;
                 let s = albedo_by_sampling(&b, wo, mode, 200_000).average();
                 let mut u = albedo_by_uniform(&b, wo, mode, 200_000).average();
@@ -516,11 +511,18 @@ mod tests {
         // R = F(10°)); with max_depth 200, 1. Both by 2·10⁵ samples (seed SEED_FURNACE)
         // to 1 %.
         for (depth, expected) in [(10, 0.9276), (200, 1.0)] {
-            let Bxdf::CoatedDiffuse(mut b) = coated(0.0, 1.0, 0.0) else { unreachable!() };
+            let Bxdf::CoatedDiffuse(mut b) = coated(0.0, 1.0, 0.0) else {
+                unreachable!()
+            };
             b.thickness = 0.0;
             b.max_depth = depth;
-            let a = albedo_by_sampling(&Bxdf::CoatedDiffuse(b), direction_at(10.0, 0.0), TransportMode::Radiance, 200_000)
-                .average();
+            let a = albedo_by_sampling(
+                &Bxdf::CoatedDiffuse(b),
+                direction_at(10.0, 0.0),
+                TransportMode::Radiance,
+                200_000,
+            )
+            .average();
             eprintln!("clear coat, max depth {depth}: albedo {a:.4} (expected {expected})");
             assert!((a / expected - 1.0).abs() < 0.01, "{depth}: {a}");
         }

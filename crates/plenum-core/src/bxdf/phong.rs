@@ -81,9 +81,13 @@ impl PhongBxdf {
             refract(wo, Vec3::Z, self.eta)
         };
         if self.fresnel {
-            let f = if self.eta == 1.0 { 0.0 } else { fr_dielectric(wo.z, self.eta) };
-            kr = kr * f;
-            kt = kt * (1.0 - f);
+            let f = if self.eta == 1.0 {
+                0.0
+            } else {
+                fr_dielectric(wo.z, self.eta)
+            };
+            kr *= f;
+            kt *= 1.0 - f;
         }
         if refracted.is_none() {
             kr += kt;
@@ -181,7 +185,11 @@ impl PhongBxdf {
                     self.f(wo, wi, mode),
                     wi,
                     pdf,
-                    if lobe == 0 { BxdfFlags::DIFFUSE_REFLECTION } else { BxdfFlags::GLOSSY_REFLECTION },
+                    if lobe == 0 {
+                        BxdfFlags::DIFFUSE_REFLECTION
+                    } else {
+                        BxdfFlags::GLOSSY_REFLECTION
+                    },
                 ))
             }
             2 => {
@@ -211,7 +219,10 @@ impl PhongBxdf {
     fn continuous_pdf(&self, wo: Vec3, wi: Vec3, w: &[f64; 4], total: f64) -> f64 {
         // Mirrored into z > 0, where the warps live.
         let side = wo.z.signum();
-        let (wo, wi) = (Vec3::new(wo.x, wo.y, wo.z * side), Vec3::new(wi.x, wi.y, wi.z * side));
+        let (wo, wi) = (
+            Vec3::new(wo.x, wo.y, wo.z * side),
+            Vec3::new(wi.x, wi.y, wi.z * side),
+        );
         let diffuse = wi.z.max(0.0) * FRAC_1_PI;
         let glossy = phong_lobe_pdf(Self::mirror(wo).dot(wi), self.exponent);
         (w[0] * diffuse + w[1] * glossy) / total
@@ -254,10 +265,25 @@ mod tests {
     #[test]
     fn chi_square_diffuse_and_glossy() {
         let b = phong(0.4, 0.6, 20.0, 0.0, 0.0, 1.0, false);
-        chi_square_bxdf("Phong k_d 0.4 + k_s 0.6, n 20", &b, direction_at(35.0, 0.8), 70);
-        chi_square_bxdf("Phong k_d 0.4 + k_s 0.6, n 20, grazing", &b, direction_at(80.0, 2.5), 71);
+        chi_square_bxdf(
+            "Phong k_d 0.4 + k_s 0.6, n 20",
+            &b,
+            direction_at(35.0, 0.8),
+            70,
+        );
+        chi_square_bxdf(
+            "Phong k_d 0.4 + k_s 0.6, n 20, grazing",
+            &b,
+            direction_at(80.0, 2.5),
+            71,
+        );
         let b = phong(0.2, 0.8, 3.0, 0.0, 0.0, 1.0, false);
-        chi_square_bxdf("Phong k_d 0.2 + k_s 0.8, n 3, from below", &b, -direction_at(50.0, 1.0), 72);
+        chi_square_bxdf(
+            "Phong k_d 0.2 + k_s 0.8, n 3, from below",
+            &b,
+            -direction_at(50.0, 1.0),
+            72,
+        );
     }
 
     #[test]
@@ -275,9 +301,16 @@ mod tests {
         ];
         for (kd, ks, n, kr, kt, eta, fresnel) in cases {
             let b = phong(kd, ks, n, kr, kt, eta, fresnel);
-            for wo in [Vec3::Z, direction_at(45.0, 0.2), direction_at(85.0, 1.0), -direction_at(60.0, 0.0)] {
+            for wo in [
+                Vec3::Z,
+                direction_at(45.0, 0.2),
+                direction_at(85.0, 1.0),
+                -direction_at(60.0, 0.0),
+            ] {
                 let a = albedo_by_sampling(&b, wo, TransportMode::Importance, 200_000).average();
-                eprintln!("Phong {kd} {ks} n {n} {kr} {kt} η {eta} fresnel {fresnel} at {wo:?}: {a:.4}");
+                eprintln!(
+                    "Phong {kd} {ks} n {n} {kr} {kt} η {eta} fresnel {fresnel} at {wo:?}: {a:.4}"
+                );
                 assert!(a <= 1.01, "{a}");
                 if kd + ks == 0.0 && !fresnel {
                     assert!((a - 1.0).abs() < 1e-12, "{a}");
@@ -297,18 +330,28 @@ mod tests {
         let wo = direction_at(60.0, 0.0);
         let f = fr_dielectric(wo.z, 1.5);
         let mode = TransportMode::Importance;
-        let r = b.sample_f(wo, 0.0, [0.0; 2], mode, SampleFlags::Reflection).unwrap();
-        let t = b.sample_f(wo, 0.0, [0.0; 2], mode, SampleFlags::Transmission).unwrap();
+        let r = b
+            .sample_f(wo, 0.0, [0.0; 2], mode, SampleFlags::Reflection)
+            .unwrap();
+        let t = b
+            .sample_f(wo, 0.0, [0.0; 2], mode, SampleFlags::Transmission)
+            .unwrap();
         assert!((r.f[0] * r.wi.z.abs() - 0.6 * f).abs() < 1e-14);
         assert!((t.f[0] * t.wi.z.abs() - 0.4 * (1.0 - f)).abs() < 1e-14);
         let inside = -direction_at(60.0, 0.0);
         let b = phong(0.0, 0.0, 1.0, 0.6, 0.4, 1.5, false);
-        assert!(b.sample_f(inside, 0.0, [0.0; 2], mode, SampleFlags::Transmission).is_none());
-        let r = b.sample_f(inside, 0.0, [0.0; 2], mode, SampleFlags::All).unwrap();
+        assert!(b
+            .sample_f(inside, 0.0, [0.0; 2], mode, SampleFlags::Transmission)
+            .is_none());
+        let r = b
+            .sample_f(inside, 0.0, [0.0; 2], mode, SampleFlags::All)
+            .unwrap();
         assert!((r.f[0] * r.wi.z.abs() / r.pdf - 1.0).abs() < 1e-14 && r.is_reflection());
         // A thin sheet passes straight through.
         let sheet = phong(0.0, 0.0, 1.0, 0.0, 1.0, 1.0, false);
-        let t = sheet.sample_f(wo, 0.5, [0.0; 2], mode, SampleFlags::All).unwrap();
+        let t = sheet
+            .sample_f(wo, 0.5, [0.0; 2], mode, SampleFlags::All)
+            .unwrap();
         assert!((t.wi + wo).length() < 1e-15);
     }
 
