@@ -20,10 +20,10 @@
 //!   path traced;
 //! - a delta mirror of weight k_r;
 //! - a delta transmission of weight k_t, refracted by Snell's law with relative `eta`
-//!   (inside over outside), or straight through for `eta == 1` (thin sheets). When
-//!   `fresnel` is set, k_r and k_t are scaled by F and 1 − F (dielectric Fresnel with
-//!   `eta`); under total internal reflection k_t joins the mirror, as in the Whitted
-//!   integrator.
+//!   (inside over outside), or straight through for a thin sheet (`thin`, or `eta == 1`),
+//!   which has no inside. When `fresnel` is set, k_r and k_t are scaled by F and 1 − F
+//!   (dielectric Fresnel with `eta`; a thin sheet looks the same from both sides); under
+//!   total internal reflection k_t joins the mirror, as in the Whitted integrator.
 //!
 //! The surface is two-sided: it scatters on wo's side as if that were the front. Sampling
 //! chooses a lobe with probability proportional to its average albedo over the lanes; the
@@ -50,8 +50,11 @@ pub struct PhongBxdf {
     pub kr: SampledSpectrum,
     /// k_t: transmittance of the refracted (or straight-through) delta lobe.
     pub kt: SampledSpectrum,
-    /// Relative index of refraction, inside over outside; 1 for a thin sheet.
+    /// Relative index of refraction, inside over outside.
     pub eta: f64,
+    /// A sheet with no inside (a polygon, an open shell): k_t passes straight through and
+    /// `eta` only weighs the Fresnel terms, as the Whitted integrator treats thin sheets.
+    pub thin: bool,
     /// Scale k_r and k_t by F and 1 − F.
     pub fresnel: bool,
 }
@@ -75,17 +78,14 @@ impl PhongBxdf {
         let (mut kr, mut kt) = (self.kr, self.kt);
         let refracted = if kt.is_black() {
             None
-        } else if self.eta == 1.0 {
+        } else if self.thin || self.eta == 1.0 {
             Some((-wo, 1.0))
         } else {
             refract(wo, Vec3::Z, self.eta)
         };
         if self.fresnel {
-            let f = if self.eta == 1.0 {
-                0.0
-            } else {
-                fr_dielectric(wo.z, self.eta)
-            };
+            let cos = if self.thin { wo.z.abs() } else { wo.z };
+            let f = fr_dielectric(cos, self.eta);
             kr *= f;
             kt *= 1.0 - f;
         }
@@ -114,7 +114,8 @@ impl PhongBxdf {
         if !self.ks.is_black() {
             flags = flags | BxdfFlags::GLOSSY_REFLECTION;
         }
-        if !self.kr.is_black() || (!self.kt.is_black() && self.eta != 1.0) {
+        let can_reflect_totally = !self.kt.is_black() && !self.thin && self.eta != 1.0;
+        if !self.kr.is_black() || can_reflect_totally {
             flags = flags | BxdfFlags::SPECULAR_REFLECTION;
         }
         if !self.kt.is_black() {
@@ -258,6 +259,7 @@ mod tests {
             kr: SampledSpectrum::splat(kr),
             kt: SampledSpectrum::splat(kt),
             eta,
+            thin: false,
             fresnel,
         })
     }
@@ -347,12 +349,24 @@ mod tests {
             .sample_f(inside, 0.0, [0.0; 2], mode, SampleFlags::All)
             .unwrap();
         assert!((r.f[0] * r.wi.z.abs() / r.pdf - 1.0).abs() < 1e-14 && r.is_reflection());
-        // A thin sheet passes straight through.
+        // A thin sheet passes straight through, from either side, with Fresnel by its η.
         let sheet = phong(0.0, 0.0, 1.0, 0.0, 1.0, 1.0, false);
         let t = sheet
             .sample_f(wo, 0.5, [0.0; 2], mode, SampleFlags::All)
             .unwrap();
         assert!((t.wi + wo).length() < 1e-15);
+        let Bxdf::Phong(mut pane) = phong(0.0, 0.0, 1.0, 0.5, 0.5, 1.5, true) else {
+            unreachable!()
+        };
+        pane.thin = true;
+        let pane = Bxdf::Phong(pane);
+        for w in [wo, -wo] {
+            let t = pane
+                .sample_f(w, 0.0, [0.0; 2], mode, SampleFlags::Transmission)
+                .unwrap();
+            assert!((t.wi + w).length() < 1e-15 && t.eta == 1.0);
+            assert!((t.f[0] * t.wi.z.abs() - 0.5 * (1.0 - f)).abs() < 1e-14);
+        }
     }
 
     #[test]
