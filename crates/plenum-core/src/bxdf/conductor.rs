@@ -152,6 +152,14 @@ mod tests {
     }
 
     #[test]
+    fn chi_square_rejects_a_wrong_roughness() {
+        // Samples of α = √0.5 tested against the pdf of α = 0.75 must be rejected: the
+        // 80 × 160 test can fail. (Not counted in TEST_COUNT: it expects a rejection.)
+        let outcome = chi_square_outcome(&rough(0.5, 0.5), &rough(0.5625, 0.5625), Vec3::Z, 99);
+        assert!(!outcome.accepted(), "{outcome:?}");
+    }
+
+    #[test]
     fn smooth_mirror_weight_is_fresnel() {
         // The delta sample's weight f·cos/pdf is F(cos θ), to 1e-14.
         let b = Bxdf::Conductor(ConductorBxdf::new(

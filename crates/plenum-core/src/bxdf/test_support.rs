@@ -7,7 +7,7 @@ use plenum_spectrum::SampledSpectrum;
 
 use super::{Bxdf, SampleFlags, TransportMode};
 use crate::math::Vec3;
-use crate::sampling::chi_square::PolarBins;
+use crate::sampling::chi_square::{Outcome, PolarBins};
 use crate::sampling::{uniform_sphere, Rng};
 
 /// Seed of every albedo estimate.
@@ -52,23 +52,26 @@ pub fn spread_directions(n: usize) -> Vec<Vec3> {
 /// at the crate's Šidák-corrected 1 % level. Failed samples count in the cell outside the
 /// sphere, which expects 1 − ∫ pdf.
 pub fn chi_square_bxdf(what: &str, bxdf: &Bxdf, wo: Vec3, seed: u64) {
+    chi_square_outcome(bxdf, bxdf, wo, seed).assert_accepted(&format!(
+        "{what}, θo = {:.1}°",
+        wo.z.clamp(-1.0, 1.0).acos().to_degrees()
+    ));
+}
+
+/// The chi-square test of `sampled`'s samples against `tested`'s pdf.
+pub fn chi_square_outcome(sampled: &Bxdf, tested: &Bxdf, wo: Vec3, seed: u64) -> Outcome {
     let mode = TransportMode::Radiance;
     let mut choice = Rng::new(seed, 7);
     let nan = Vec3::splat(f64::NAN);
-    PolarBins::about_z(CHI_SQUARE_BINS)
-        .test(
-            CHI_SQUARE_SAMPLES,
-            seed,
-            |u| match bxdf.sample_f(wo, choice.uniform(), u, mode, SampleFlags::All) {
-                Some(s) if !s.is_specular() && s.pdf > 0.0 => s.wi,
-                _ => nan,
-            },
-            |wi| bxdf.pdf(wo, wi, mode, SampleFlags::All),
-        )
-        .assert_accepted(&format!(
-            "{what}, θo = {:.1}°",
-            wo.z.clamp(-1.0, 1.0).acos().to_degrees()
-        ));
+    PolarBins::about_z(CHI_SQUARE_BINS).test(
+        CHI_SQUARE_SAMPLES,
+        seed,
+        |u| match sampled.sample_f(wo, choice.uniform(), u, mode, SampleFlags::All) {
+            Some(s) if !s.is_specular() && s.pdf > 0.0 => s.wi,
+            _ => nan,
+        },
+        |wi| tested.pdf(wo, wi, mode, SampleFlags::All),
+    )
 }
 
 /// ∫ f(wo, wi) |cos θi| dωi over the sphere by importance sampling: the mean of
