@@ -98,9 +98,7 @@ impl ConductorBxdf {
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3, _mode: TransportMode, which: SampleFlags) -> f64 {
-        if !which.reflection()
-            || !same_hemisphere(wo, wi)
-            || self.distribution.effectively_smooth()
+        if !which.reflection() || !same_hemisphere(wo, wi) || self.distribution.effectively_smooth()
         {
             return 0.0;
         }
@@ -154,6 +152,14 @@ mod tests {
     }
 
     #[test]
+    fn chi_square_rejects_a_wrong_roughness() {
+        // Samples of α = √0.5 tested against the pdf of α = 0.75 must be rejected: the
+        // 80 × 160 test can fail. (Not counted in TEST_COUNT: it expects a rejection.)
+        let outcome = chi_square_outcome(&rough(0.5, 0.5), &rough(0.5625, 0.5625), Vec3::Z, 99);
+        assert!(!outcome.accepted(), "{outcome:?}");
+    }
+
+    #[test]
     fn smooth_mirror_weight_is_fresnel() {
         // The delta sample's weight f·cos/pdf is F(cos θ), to 1e-14.
         let b = Bxdf::Conductor(ConductorBxdf::new(
@@ -163,9 +169,19 @@ mod tests {
         ));
         let wo = Vec3::new(0.5, 0.1, 0.7).normalized();
         let s = b
-            .sample_f(wo, 0.5, [0.5, 0.5], TransportMode::Radiance, SampleFlags::All)
+            .sample_f(
+                wo,
+                0.5,
+                [0.5, 0.5],
+                TransportMode::Radiance,
+                SampleFlags::All,
+            )
             .unwrap();
-        let f = fr_complex(wo.z, SampledSpectrum::splat(2.0), SampledSpectrum::splat(4.0));
+        let f = fr_complex(
+            wo.z,
+            SampledSpectrum::splat(2.0),
+            SampledSpectrum::splat(4.0),
+        );
         assert!(s.is_specular());
         assert!((s.f[0] * s.wi.z / s.pdf - f[0]).abs() < 1e-14);
         assert!((s.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-15);
@@ -190,8 +206,8 @@ mod tests {
                 };
                 let wm = direction_at(theta_m.to_degrees(), 0.0);
                 let wi = direction_at((2.0 * theta_m).to_degrees(), 0.0);
-                let integrand = tr.d(wm) * wm.z * theta_m.sin() * std::f64::consts::TAU
-                    / (1.0 + tr.lambda(wi));
+                let integrand =
+                    tr.d(wm) * wm.z * theta_m.sin() * std::f64::consts::TAU / (1.0 + tr.lambda(wi));
                 weight * integrand
             })
             .sum::<f64>()
@@ -210,7 +226,9 @@ mod tests {
             let a = albedo_by_sampling(&perfect(alpha), Vec3::Z, TransportMode::Radiance, 200_000)
                 .average();
             let q = normal_incidence_albedo(alpha);
-            eprintln!("conductor F = 1, α = {alpha}, normal incidence: albedo {a:.4}, quadrature {q:.4}");
+            eprintln!(
+                "conductor F = 1, α = {alpha}, normal incidence: albedo {a:.4}, quadrature {q:.4}"
+            );
             assert!((a / q - 1.0).abs() < 0.01, "α {alpha}: {a} vs {q}");
         }
         // At 80°, bounds around the measured values: α 0.1: 0.895; α 0.5: 0.805.

@@ -14,9 +14,7 @@ use plenum_spectrum::SampledSpectrum;
 
 use super::fresnel::fr_dielectric;
 use super::microfacet::TrowbridgeReitz;
-use super::{
-    reflect, refract, same_hemisphere, BsdfSample, BxdfFlags, SampleFlags, TransportMode,
-};
+use super::{reflect, refract, same_hemisphere, BsdfSample, BxdfFlags, SampleFlags, TransportMode};
 use crate::math::Vec3;
 
 #[derive(Clone, Copy, Debug)]
@@ -150,7 +148,9 @@ impl DielectricBxdf {
             let denominator = (wi.dot(wm) + wo.dot(wm) / etap).powi(2);
             let dwm_dwi = wi.dot(wm).abs() / denominator;
             let pdf = dist.pdf(wo, wm) * dwm_dwi * pt / (pr + pt);
-            let mut t = (1.0 - r) * dist.d(wm) * dist.g(wo, wi)
+            let mut t = (1.0 - r)
+                * dist.d(wm)
+                * dist.g(wo, wi)
                 * (wi.dot(wm) * wo.dot(wm) / (wi.z * wo.z * denominator)).abs();
             if mode == TransportMode::Radiance {
                 t /= etap * etap;
@@ -258,7 +258,9 @@ mod tests {
     fn smooth_r_t(eta: f64, wo: Vec3) -> (f64, f64) {
         let b = smooth(eta);
         let mode = TransportMode::Radiance;
-        let r = b.sample_f(wo, 0.0, [0.5; 2], mode, SampleFlags::Reflection).unwrap();
+        let r = b
+            .sample_f(wo, 0.0, [0.5; 2], mode, SampleFlags::Reflection)
+            .unwrap();
         let weight_r = r.f[0] * r.wi.z.abs();
         let weight_t = b
             .sample_f(wo, 0.0, [0.5; 2], mode, SampleFlags::Transmission)
@@ -272,14 +274,27 @@ mod tests {
         // F = 0.387704354691473 to 1e-12; the sample carries η = 1.5.
         let wo = direction_at(80.0, 0.0);
         let t = smooth(1.5)
-            .sample_f(wo, 0.999, [0.5; 2], TransportMode::Radiance, SampleFlags::All)
+            .sample_f(
+                wo,
+                0.999,
+                [0.5; 2],
+                TransportMode::Radiance,
+                SampleFlags::All,
+            )
             .unwrap();
         assert!(t.is_transmission() && t.is_specular());
         let theta_t = (-t.wi.z).acos().to_degrees();
         assert!((theta_t - 41.03641052520335).abs() < 1e-9, "{theta_t}");
-        assert!((t.pdf - (1.0 - 0.387704354691473)).abs() < 1e-12, "{}", t.pdf);
+        assert!(
+            (t.pdf - (1.0 - 0.387704354691473)).abs() < 1e-12,
+            "{}",
+            t.pdf
+        );
         assert_eq!(t.eta, 1.5);
-        assert!(t.wi.x < 0.0 && t.wi.y.abs() < 1e-15, "wi continues wo's path across the normal");
+        assert!(
+            t.wi.x < 0.0 && t.wi.y.abs() < 1e-15,
+            "wi continues wo's path across the normal"
+        );
         assert!((t.wi.length() - 1.0).abs() < 1e-14);
     }
 
@@ -294,7 +309,10 @@ mod tests {
                     let mut wo = direction_at(deg, 0.7);
                     wo.z *= side;
                     let (r, t) = smooth_r_t(eta, wo);
-                    assert!((r + t - 1.0).abs() < 1e-12, "η {eta} {deg}° side {side}: {r} + {t}");
+                    assert!(
+                        (r + t - 1.0).abs() < 1e-12,
+                        "η {eta} {deg}° side {side}: {r} + {t}"
+                    );
                 }
             }
         }
@@ -309,9 +327,13 @@ mod tests {
         let r = fr_dielectric(wo.z, 1.5);
         let b = smooth(1.5);
         let mode = TransportMode::Radiance;
-        let s = b.sample_f(wo, r * 0.999, [0.5; 2], mode, SampleFlags::All).unwrap();
+        let s = b
+            .sample_f(wo, r * 0.999, [0.5; 2], mode, SampleFlags::All)
+            .unwrap();
         assert!(s.is_reflection() && (s.pdf - r).abs() < 1e-15);
-        let s = b.sample_f(wo, r * 1.001, [0.5; 2], mode, SampleFlags::All).unwrap();
+        let s = b
+            .sample_f(wo, r * 1.001, [0.5; 2], mode, SampleFlags::All)
+            .unwrap();
         assert!(s.is_transmission());
         assert_eq!(b.f(wo, s.wi, mode)[0], 0.0);
         assert_eq!(b.pdf(wo, s.wi, mode, SampleFlags::All), 0.0);
@@ -321,7 +343,12 @@ mod tests {
     fn chi_square_rough_outside() {
         for (eta, seed) in [(1.5, 30), (1.0 / 1.5, 31)] {
             for (k, wo) in incidences().into_iter().enumerate() {
-                chi_square_bxdf(&format!("rough dielectric η {eta:.3} outside"), &rough(eta, 0.3), wo, seed * 10 + k as u64);
+                chi_square_bxdf(
+                    &format!("rough dielectric η {eta:.3} outside"),
+                    &rough(eta, 0.3),
+                    wo,
+                    seed * 10 + k as u64,
+                );
             }
         }
     }
@@ -334,7 +361,12 @@ mod tests {
             for (k, deg) in [30.0, 60.0].into_iter().enumerate() {
                 let mut wo = direction_at(deg, 0.4);
                 wo.z = -wo.z;
-                chi_square_bxdf(&format!("rough dielectric η {eta:.3} inside {deg}°"), &rough(eta, 0.3), wo, seed * 10 + k as u64);
+                chi_square_bxdf(
+                    &format!("rough dielectric η {eta:.3} inside {deg}°"),
+                    &rough(eta, 0.3),
+                    wo,
+                    seed * 10 + k as u64,
+                );
             }
         }
     }
@@ -343,7 +375,12 @@ mod tests {
     fn chi_square_rough_grazing() {
         for (eta, seed) in [(1.5, 50), (1.0 / 1.5, 51)] {
             let wo = direction_at(86.0, 0.2);
-            chi_square_bxdf(&format!("rough dielectric η {eta:.3} grazing 86°"), &rough(eta, 0.5), wo, seed);
+            chi_square_bxdf(
+                &format!("rough dielectric η {eta:.3} grazing 86°"),
+                &rough(eta, 0.5),
+                wo,
+                seed,
+            );
         }
     }
 
@@ -373,8 +410,13 @@ mod tests {
                 for (k, wo) in incidences().into_iter().enumerate() {
                     for side in [1.0, -1.0] {
                         let wo = Vec3::new(wo.x, wo.y, wo.z * side);
-                        let a = albedo_by_sampling(&rough(eta, alpha), wo, TransportMode::Importance, 200_000)
-                            .average();
+                        let a = albedo_by_sampling(
+                            &rough(eta, alpha),
+                            wo,
+                            TransportMode::Importance,
+                            200_000,
+                        )
+                        .average();
                         eprintln!("rough dielectric η {eta:.3} α {alpha} wo {wo:?}: albedo {a:.4}");
                         assert!(a <= 1.01, "η {eta} α {alpha} {wo:?}: {a}");
                         if k < 2 && side > 0.0 && eta > 1.0 {

@@ -88,15 +88,26 @@ mod tests {
                 let wo = Vec3::new(0.2, 0.1, side).normalized();
                 let expected = w.z.abs() / std::f64::consts::PI;
                 let pdf = b.pdf(wo, w, TransportMode::Radiance, SampleFlags::All);
-                assert!((pdf - expected).abs() <= 2.3e-16 * expected, "{pdf} vs {expected}");
-                assert_eq!(b.pdf(-wo, w, TransportMode::Radiance, SampleFlags::All), 0.0);
+                assert!(
+                    (pdf - expected).abs() <= 2.3e-16 * expected,
+                    "{pdf} vs {expected}"
+                );
+                assert_eq!(
+                    b.pdf(-wo, w, TransportMode::Radiance, SampleFlags::All),
+                    0.0
+                );
             }
         }
     }
 
     #[test]
     fn chi_square_lambert() {
-        chi_square_bxdf("Lambert", &white(), Vec3::new(0.3, 0.2, 0.9).normalized(), 1);
+        chi_square_bxdf(
+            "Lambert",
+            &white(),
+            Vec3::new(0.3, 0.2, 0.9).normalized(),
+            1,
+        );
     }
 
     #[test]
@@ -107,7 +118,10 @@ mod tests {
         for wo in spread_directions(5) {
             let by_sampling = albedo_by_sampling(&b, wo, TransportMode::Radiance, 100_000);
             let uniform = albedo_by_uniform(&b, wo, TransportMode::Radiance, 200_000);
-            assert!((by_sampling.average() - 1.0).abs() < 1e-12, "{by_sampling:?}");
+            assert!(
+                (by_sampling.average() - 1.0).abs() < 1e-12,
+                "{by_sampling:?}"
+            );
             let u = uniform.average();
             assert!((0.99..=1.01).contains(&u), "{wo:?}: {u}");
         }

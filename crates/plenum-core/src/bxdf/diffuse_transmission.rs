@@ -34,8 +34,16 @@ impl DiffuseTransmissionBxdf {
     }
 
     fn weights(&self, which: SampleFlags) -> (f64, f64) {
-        let pr = if which.reflection() { self.r.average() } else { 0.0 };
-        let pt = if which.transmission() { self.t.average() } else { 0.0 };
+        let pr = if which.reflection() {
+            self.r.average()
+        } else {
+            0.0
+        };
+        let pt = if which.transmission() {
+            self.t.average()
+        } else {
+            0.0
+        };
         (pr, pt)
     }
 
@@ -100,7 +108,12 @@ mod tests {
     #[test]
     fn chi_square_both_sides() {
         chi_square_bxdf("diffuse transmission", &leaf(), direction_at(40.0, 0.5), 60);
-        chi_square_bxdf("diffuse transmission from below", &leaf(), -direction_at(70.0, 2.0), 61);
+        chi_square_bxdf(
+            "diffuse transmission from below",
+            &leaf(),
+            -direction_at(70.0, 2.0),
+            61,
+        );
     }
 
     #[test]

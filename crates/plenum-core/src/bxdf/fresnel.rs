@@ -152,18 +152,31 @@ mod tests {
             let f = fr_complex(c, SampledSpectrum::splat(1.5), SampledSpectrum::ZERO);
             assert!((f[0] - fr_dielectric(c, 1.5)).abs() < 1e-13, "{deg}°");
         }
-        let f = fr_complex(0.0, SampledSpectrum::splat(2.0), SampledSpectrum::splat(4.0));
+        let f = fr_complex(
+            0.0,
+            SampledSpectrum::splat(2.0),
+            SampledSpectrum::splat(4.0),
+        );
         assert!((f[0] - 1.0).abs() < 1e-12);
     }
 
     #[test]
     fn complex_sqrt_squares_back() {
-        for (re, im) in [(3.0, 4.0), (-3.0, 4.0), (-3.0, -4.0), (1e-9, -2.0), (-5.0, 0.0)] {
+        for (re, im) in [
+            (3.0, 4.0),
+            (-3.0, 4.0),
+            (-3.0, -4.0),
+            (1e-9, -2.0),
+            (-5.0, 0.0),
+        ] {
             let z = Complex::new(re, im);
             let s = z.sqrt();
             let back = s.mul(s);
             assert!(s.re >= 0.0);
-            assert!((back.re - re).abs() < 1e-12 && (back.im - im).abs() < 1e-12, "{z:?}");
+            assert!(
+                (back.re - re).abs() < 1e-12 && (back.im - im).abs() < 1e-12,
+                "{z:?}"
+            );
         }
     }
 }

@@ -70,7 +70,8 @@ impl TrowbridgeReitz {
             return 0.0;
         }
         let (cos2_phi, sin2_phi) = cos2_sin2_phi(w);
-        let alpha2 = cos2_phi * self.alpha_x * self.alpha_x + sin2_phi * self.alpha_y * self.alpha_y;
+        let alpha2 =
+            cos2_phi * self.alpha_x * self.alpha_x + sin2_phi * self.alpha_y * self.alpha_y;
         0.5 * ((1.0 + alpha2 * tan2).sqrt() - 1.0)
     }
 
@@ -159,7 +160,11 @@ mod tests {
         // 4·10⁵ uniform samples, seed SEED, to 3 %. (d_visible takes |w·wm| as pbrt-v4 does;
         // sample_wm never returns a back-facing normal.)
         let tr = TrowbridgeReitz::new(0.4, 0.25);
-        for w in [Vec3::Z, Vec3::new(0.6, 0.3, 0.5).normalized(), Vec3::new(0.99, 0.0, 0.1).normalized()] {
+        for w in [
+            Vec3::Z,
+            Vec3::new(0.6, 0.3, 0.5).normalized(),
+            Vec3::new(0.99, 0.0, 0.1).normalized(),
+        ] {
             let mut rng = Rng::new(SEED, 2);
             let n = 400_000;
             let mut sum = 0.0;

@@ -270,7 +270,11 @@ impl Bsdf {
         let frame = match tangent {
             Some(t) => {
                 let x = t.normalized();
-                Frame { x, y: n.cross(x), z: n }
+                Frame {
+                    x,
+                    y: n.cross(x),
+                    z: n,
+                }
             }
             None => Frame::from_z(n),
         };
@@ -362,4 +366,58 @@ fn refract(wi: Vec3, n: Vec3, eta: f64) -> Option<(Vec3, f64)> {
     }
     let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
     Some((-wi / eta + n * (cos_i / eta - cos_t), eta))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::Rng;
+
+    #[test]
+    fn flags_combine_and_query() {
+        let f = BxdfFlags::GLOSSY_REFLECTION | BxdfFlags::SPECULAR_TRANSMISSION;
+        assert!(f.contains(BxdfFlags::REFLECTION) && f.contains(BxdfFlags::TRANSMISSION));
+        assert!(f.is_specular() && f.is_non_specular() && f.is_reflective() && f.is_transmissive());
+        assert!(!BxdfFlags::DIFFUSE_REFLECTION.is_specular());
+        assert!(!BxdfFlags::SPECULAR_REFLECTION.is_non_specular());
+        assert!(BxdfFlags::UNSET.is_empty());
+    }
+
+    #[test]
+    fn bsdf_frame_follows_the_normal_and_the_tangent_hint() {
+        // z = n, x = the hint projected onto the tangent plane, to 1e-12; the anisotropic
+        // conductor's value in world space equals the local one in that frame.
+        let n = Vec3::new(0.2, -0.4, 0.9).normalized();
+        let hint = Vec3::new(1.0, 0.3, 0.0);
+        let bxdf = Bxdf::Conductor(ConductorBxdf::new(
+            TrowbridgeReitz::new(0.5, 0.1),
+            SampledSpectrum::splat(2.0),
+            SampledSpectrum::splat(4.0),
+        ));
+        let bsdf = Bsdf::new(n, Some(hint), bxdf);
+        let x = (hint - n * n.dot(hint)).normalized();
+        assert!((bsdf.to_world(Vec3::Z) - n).length() < 1e-12);
+        assert!((bsdf.to_world(Vec3::X) - x).length() < 1e-12);
+        let mut rng = Rng::new(11, 0);
+        let mode = TransportMode::Radiance;
+        for _ in 0..100 {
+            let u = [rng.uniform(), rng.uniform()];
+            let wo_local = crate::sampling::cosine_hemisphere([rng.uniform(), rng.uniform()]);
+            let wo = bsdf.to_world(wo_local);
+            // A microfacet may reflect below the horizon: no sample then.
+            let Some(s) = bsdf.sample_f(wo, rng.uniform(), u, mode) else {
+                continue;
+            };
+            let wi_local = bsdf.to_local(s.wi);
+            let local = bxdf.f(wo_local, wi_local, mode)[0];
+            assert!((bsdf.f(wo, s.wi, mode)[0] - local).abs() <= 1e-9 * local);
+            assert!((bsdf.f(wo, s.wi, mode)[0] - s.f[0]).abs() <= 1e-9 * local);
+            let pdf = bsdf.pdf(wo, s.wi, mode);
+            assert!((pdf - s.pdf).abs() <= 1e-9 * pdf);
+        }
+        // A hint along the normal falls back to some tangent frame.
+        let b = Bsdf::new(n, Some(n * 3.0), bxdf);
+        assert!((b.to_world(Vec3::Z) - n).length() < 1e-12);
+        assert!(b.to_world(Vec3::X).dot(n).abs() < 1e-12);
+    }
 }

@@ -20,10 +20,10 @@
 //!   path traced;
 //! - a delta mirror of weight k_r;
 //! - a delta transmission of weight k_t, refracted by Snell's law with relative `eta`
-//!   (inside over outside), or straight through for `eta == 1` (thin sheets). When
-//!   `fresnel` is set, k_r and k_t are scaled by F and 1 − F (dielectric Fresnel with
-//!   `eta`); under total internal reflection k_t joins the mirror, as in the Whitted
-//!   integrator.
+//!   (inside over outside), or straight through for a thin sheet (`thin`, or `eta == 1`),
+//!   which has no inside. When `fresnel` is set, k_r and k_t are scaled by F and 1 − F
+//!   (dielectric Fresnel with `eta`; a thin sheet looks the same from both sides); under
+//!   total internal reflection k_t joins the mirror, as in the Whitted integrator.
 //!
 //! The surface is two-sided: it scatters on wo's side as if that were the front. Sampling
 //! chooses a lobe with probability proportional to its average albedo over the lanes; the
@@ -50,8 +50,11 @@ pub struct PhongBxdf {
     pub kr: SampledSpectrum,
     /// k_t: transmittance of the refracted (or straight-through) delta lobe.
     pub kt: SampledSpectrum,
-    /// Relative index of refraction, inside over outside; 1 for a thin sheet.
+    /// Relative index of refraction, inside over outside.
     pub eta: f64,
+    /// A sheet with no inside (a polygon, an open shell): k_t passes straight through and
+    /// `eta` only weighs the Fresnel terms, as the Whitted integrator treats thin sheets.
+    pub thin: bool,
     /// Scale k_r and k_t by F and 1 − F.
     pub fresnel: bool,
 }
@@ -75,15 +78,16 @@ impl PhongBxdf {
         let (mut kr, mut kt) = (self.kr, self.kt);
         let refracted = if kt.is_black() {
             None
-        } else if self.eta == 1.0 {
+        } else if self.thin || self.eta == 1.0 {
             Some((-wo, 1.0))
         } else {
             refract(wo, Vec3::Z, self.eta)
         };
         if self.fresnel {
-            let f = if self.eta == 1.0 { 0.0 } else { fr_dielectric(wo.z, self.eta) };
-            kr = kr * f;
-            kt = kt * (1.0 - f);
+            let cos = if self.thin { wo.z.abs() } else { wo.z };
+            let f = fr_dielectric(cos, self.eta);
+            kr *= f;
+            kt *= 1.0 - f;
         }
         if refracted.is_none() {
             kr += kt;
@@ -110,7 +114,8 @@ impl PhongBxdf {
         if !self.ks.is_black() {
             flags = flags | BxdfFlags::GLOSSY_REFLECTION;
         }
-        if !self.kr.is_black() || (!self.kt.is_black() && self.eta != 1.0) {
+        let can_reflect_totally = !self.kt.is_black() && !self.thin && self.eta != 1.0;
+        if !self.kr.is_black() || can_reflect_totally {
             flags = flags | BxdfFlags::SPECULAR_REFLECTION;
         }
         if !self.kt.is_black() {
@@ -181,7 +186,11 @@ impl PhongBxdf {
                     self.f(wo, wi, mode),
                     wi,
                     pdf,
-                    if lobe == 0 { BxdfFlags::DIFFUSE_REFLECTION } else { BxdfFlags::GLOSSY_REFLECTION },
+                    if lobe == 0 {
+                        BxdfFlags::DIFFUSE_REFLECTION
+                    } else {
+                        BxdfFlags::GLOSSY_REFLECTION
+                    },
                 ))
             }
             2 => {
@@ -211,7 +220,10 @@ impl PhongBxdf {
     fn continuous_pdf(&self, wo: Vec3, wi: Vec3, w: &[f64; 4], total: f64) -> f64 {
         // Mirrored into z > 0, where the warps live.
         let side = wo.z.signum();
-        let (wo, wi) = (Vec3::new(wo.x, wo.y, wo.z * side), Vec3::new(wi.x, wi.y, wi.z * side));
+        let (wo, wi) = (
+            Vec3::new(wo.x, wo.y, wo.z * side),
+            Vec3::new(wi.x, wi.y, wi.z * side),
+        );
         let diffuse = wi.z.max(0.0) * FRAC_1_PI;
         let glossy = phong_lobe_pdf(Self::mirror(wo).dot(wi), self.exponent);
         (w[0] * diffuse + w[1] * glossy) / total
@@ -247,6 +259,7 @@ mod tests {
             kr: SampledSpectrum::splat(kr),
             kt: SampledSpectrum::splat(kt),
             eta,
+            thin: false,
             fresnel,
         })
     }
@@ -254,10 +267,25 @@ mod tests {
     #[test]
     fn chi_square_diffuse_and_glossy() {
         let b = phong(0.4, 0.6, 20.0, 0.0, 0.0, 1.0, false);
-        chi_square_bxdf("Phong k_d 0.4 + k_s 0.6, n 20", &b, direction_at(35.0, 0.8), 70);
-        chi_square_bxdf("Phong k_d 0.4 + k_s 0.6, n 20, grazing", &b, direction_at(80.0, 2.5), 71);
+        chi_square_bxdf(
+            "Phong k_d 0.4 + k_s 0.6, n 20",
+            &b,
+            direction_at(35.0, 0.8),
+            70,
+        );
+        chi_square_bxdf(
+            "Phong k_d 0.4 + k_s 0.6, n 20, grazing",
+            &b,
+            direction_at(80.0, 2.5),
+            71,
+        );
         let b = phong(0.2, 0.8, 3.0, 0.0, 0.0, 1.0, false);
-        chi_square_bxdf("Phong k_d 0.2 + k_s 0.8, n 3, from below", &b, -direction_at(50.0, 1.0), 72);
+        chi_square_bxdf(
+            "Phong k_d 0.2 + k_s 0.8, n 3, from below",
+            &b,
+            -direction_at(50.0, 1.0),
+            72,
+        );
     }
 
     #[test]
@@ -275,9 +303,16 @@ mod tests {
         ];
         for (kd, ks, n, kr, kt, eta, fresnel) in cases {
             let b = phong(kd, ks, n, kr, kt, eta, fresnel);
-            for wo in [Vec3::Z, direction_at(45.0, 0.2), direction_at(85.0, 1.0), -direction_at(60.0, 0.0)] {
+            for wo in [
+                Vec3::Z,
+                direction_at(45.0, 0.2),
+                direction_at(85.0, 1.0),
+                -direction_at(60.0, 0.0),
+            ] {
                 let a = albedo_by_sampling(&b, wo, TransportMode::Importance, 200_000).average();
-                eprintln!("Phong {kd} {ks} n {n} {kr} {kt} η {eta} fresnel {fresnel} at {wo:?}: {a:.4}");
+                eprintln!(
+                    "Phong {kd} {ks} n {n} {kr} {kt} η {eta} fresnel {fresnel} at {wo:?}: {a:.4}"
+                );
                 assert!(a <= 1.01, "{a}");
                 if kd + ks == 0.0 && !fresnel {
                     assert!((a - 1.0).abs() < 1e-12, "{a}");
@@ -297,19 +332,41 @@ mod tests {
         let wo = direction_at(60.0, 0.0);
         let f = fr_dielectric(wo.z, 1.5);
         let mode = TransportMode::Importance;
-        let r = b.sample_f(wo, 0.0, [0.0; 2], mode, SampleFlags::Reflection).unwrap();
-        let t = b.sample_f(wo, 0.0, [0.0; 2], mode, SampleFlags::Transmission).unwrap();
+        let r = b
+            .sample_f(wo, 0.0, [0.0; 2], mode, SampleFlags::Reflection)
+            .unwrap();
+        let t = b
+            .sample_f(wo, 0.0, [0.0; 2], mode, SampleFlags::Transmission)
+            .unwrap();
         assert!((r.f[0] * r.wi.z.abs() - 0.6 * f).abs() < 1e-14);
         assert!((t.f[0] * t.wi.z.abs() - 0.4 * (1.0 - f)).abs() < 1e-14);
         let inside = -direction_at(60.0, 0.0);
         let b = phong(0.0, 0.0, 1.0, 0.6, 0.4, 1.5, false);
-        assert!(b.sample_f(inside, 0.0, [0.0; 2], mode, SampleFlags::Transmission).is_none());
-        let r = b.sample_f(inside, 0.0, [0.0; 2], mode, SampleFlags::All).unwrap();
+        assert!(b
+            .sample_f(inside, 0.0, [0.0; 2], mode, SampleFlags::Transmission)
+            .is_none());
+        let r = b
+            .sample_f(inside, 0.0, [0.0; 2], mode, SampleFlags::All)
+            .unwrap();
         assert!((r.f[0] * r.wi.z.abs() / r.pdf - 1.0).abs() < 1e-14 && r.is_reflection());
-        // A thin sheet passes straight through.
+        // A thin sheet passes straight through, from either side, with Fresnel by its η.
         let sheet = phong(0.0, 0.0, 1.0, 0.0, 1.0, 1.0, false);
-        let t = sheet.sample_f(wo, 0.5, [0.0; 2], mode, SampleFlags::All).unwrap();
+        let t = sheet
+            .sample_f(wo, 0.5, [0.0; 2], mode, SampleFlags::All)
+            .unwrap();
         assert!((t.wi + wo).length() < 1e-15);
+        let Bxdf::Phong(mut pane) = phong(0.0, 0.0, 1.0, 0.5, 0.5, 1.5, true) else {
+            unreachable!()
+        };
+        pane.thin = true;
+        let pane = Bxdf::Phong(pane);
+        for w in [wo, -wo] {
+            let t = pane
+                .sample_f(w, 0.0, [0.0; 2], mode, SampleFlags::Transmission)
+                .unwrap();
+            assert!((t.wi + w).length() < 1e-15 && t.eta == 1.0);
+            assert!((t.f[0] * t.wi.z.abs() - 0.5 * (1.0 - f)).abs() < 1e-14);
+        }
     }
 
     #[test]

@@ -57,11 +57,21 @@ impl ThinDielectricBxdf {
         if uc < pr / (pr + pt) {
             let wi = Vec3::new(-wo.x, -wo.y, wo.z);
             let f = SampledSpectrum::splat(r / cos);
-            Some(BsdfSample::new(f, wi, pr / (pr + pt), BxdfFlags::SPECULAR_REFLECTION))
+            Some(BsdfSample::new(
+                f,
+                wi,
+                pr / (pr + pt),
+                BxdfFlags::SPECULAR_REFLECTION,
+            ))
         } else {
             // Both interfaces are crossed, in and out: the radiance scalings cancel.
             let f = SampledSpectrum::splat(t / cos);
-            Some(BsdfSample::new(f, -wo, pt / (pr + pt), BxdfFlags::SPECULAR_TRANSMISSION))
+            Some(BsdfSample::new(
+                f,
+                -wo,
+                pt / (pr + pt),
+                BxdfFlags::SPECULAR_TRANSMISSION,
+            ))
         }
     }
 
@@ -86,8 +96,12 @@ mod tests {
                 let mut wo = direction_at(k as f64, 0.2);
                 wo.z *= side;
                 let mode = TransportMode::Radiance;
-                let r = b.sample_f(wo, 0.0, [0.0; 2], mode, SampleFlags::Reflection).unwrap();
-                let t = b.sample_f(wo, 0.0, [0.0; 2], mode, SampleFlags::Transmission).unwrap();
+                let r = b
+                    .sample_f(wo, 0.0, [0.0; 2], mode, SampleFlags::Reflection)
+                    .unwrap();
+                let t = b
+                    .sample_f(wo, 0.0, [0.0; 2], mode, SampleFlags::Transmission)
+                    .unwrap();
                 let sum = r.f[0] * r.wi.z.abs() + t.f[0] * t.wi.z.abs();
                 assert!((sum - 1.0).abs() < 1e-12, "{k}° {side}: {sum}");
                 assert!((t.wi + wo).length() < 1e-15 && t.eta == 1.0);
