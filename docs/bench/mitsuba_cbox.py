@@ -29,6 +29,7 @@ since the project's machines are shared.
 import argparse
 import json
 import os
+import resource
 import statistics
 import sys
 import tempfile
@@ -58,6 +59,8 @@ def parse_args():
     p.add_argument("--ref-var", help="reference variance EXR (default: beside --ref)")
     p.add_argument("--cold-cache", action="store_true",
                    help="use an empty Dr.Jit kernel cache (HOME set to a temporary folder)")
+    p.add_argument("--no-compare", action="store_true",
+                   help="skip the reference (no EXR reads: for whole-process timings)")
     p.add_argument("--quiet-summary", action="store_true", help="print only the summary line")
     return p.parse_args()
 
@@ -90,6 +93,16 @@ def main():
     dr.set_thread_count(args.threads)
     import_s = time.perf_counter() - t_import
 
+    def bitmap_io(fn):
+        # Bitmap's EXR reader and writer hang when Dr.Jit's pool has no worker thread
+        # (--threads 1, Mitsuba 3.9.1): give them two threads for the I/O only.
+        if args.threads < 2:
+            dr.set_thread_count(2)
+        try:
+            return fn()
+        finally:
+            dr.set_thread_count(args.threads)
+
     def emit(obj):
         if not args.quiet_summary or obj.get("event") == "summary":
             print(json.dumps(obj), flush=True)
@@ -104,12 +117,20 @@ def main():
     scene = mi.load_dict(scene_dict)
     load_s = time.perf_counter() - t0
 
+    def cpu():
+        r = resource.getrusage(resource.RUSAGE_SELF)
+        return r.ru_utime + r.ru_stime
+
+    cpu_s = []  # CPU time of this process per render: about threads x wall when not crowded
+
     def render(seed):
+        c = cpu()
         t = time.perf_counter()
         img = mi.render(scene, spp=args.spp, seed=seed)
         dr.eval(img)
         dr.sync_thread()
         s = time.perf_counter() - t
+        cpu_s.append(cpu() - c)
         return np.array(img, dtype=np.float64), s
 
     # The first render, with kernel metadata: was it compiled, or loaded from the disk cache?
@@ -127,7 +148,7 @@ def main():
         "execution_ms": round(sum(h.get("execution_time", 0.0) for h in jit), 2),
     }
     emit({"event": "first", "variant": args.variant, "spp": args.spp, "seed": args.seed,
-          "threads": dr.thread_count(), "seconds": round(first_s, 4), "import_s": round(import_s, 3),
+          "threads": dr.thread_count(), "seconds": round(first_s, 4), "cpu_s": round(cpu_s[-1], 3), "import_s": round(import_s, 3),
           "load_scene_s": round(load_s, 4), "kernels": kernels, "loadavg": os.getloadavg()[0]})
 
     steady = []
@@ -138,16 +159,16 @@ def main():
         acc += img
         acc2 += img * img
         n += 1
-        emit({"event": "steady", "round": i, "seconds": round(s, 4), "loadavg": os.getloadavg()[0]})
+        emit({"event": "steady", "round": i, "seconds": round(s, 4), "cpu_s": round(cpu_s[-1], 3), "loadavg": os.getloadavg()[0]})
 
     if args.out:
-        mi.Bitmap(first.astype(np.float32), mi.Bitmap.PixelFormat.RGB).write(args.out)
+        bitmap_io(lambda: mi.Bitmap(first.astype(np.float32), mi.Bitmap.PixelFormat.RGB).write(args.out))
     if args.var_out:
         if n < 2:
             sys.exit("--var-out needs --rounds 1 or more")
         mean = acc / n
         var = np.maximum(acc2 / n - mean * mean, 0.0) * n / (n - 1)
-        mi.Bitmap(var.astype(np.float32), mi.Bitmap.PixelFormat.RGB).write(args.var_out)
+        bitmap_io(lambda: mi.Bitmap(var.astype(np.float32), mi.Bitmap.PixelFormat.RGB).write(args.var_out))
 
     summary = {"event": "summary", "variant": args.variant, "spp": args.spp,
                "res": args.res, "max_depth": args.max_depth, "threads": dr.thread_count(),
@@ -155,11 +176,14 @@ def main():
                "first_s": round(first_s, 4),
                "steady_median_s": round(statistics.median(steady), 4) if steady else None,
                "steady_s": [round(s, 4) for s in steady],
+               "first_cpu_s": round(cpu_s[0], 3),
+               "steady_cpu_median_s": round(statistics.median(cpu_s[1:]), 3) if steady else None,
+               "cpu_per_wall": round(sum(cpu_s) / (first_s + sum(steady)), 3),
                "load_scene_s": round(load_s, 4), "import_s": round(import_s, 3),
                "mean_rgb": [float(x) for x in first.reshape(-1, 3).mean(0)]}
     ref_path, ref_var_path, meta_path = reference_paths(args)
-    if os.path.exists(ref_path) and args.res == 256:
-        ref = np.array(mi.Bitmap(ref_path), dtype=np.float64)[..., :3]
+    if os.path.exists(ref_path) and args.res == 256 and not args.no_compare:
+        ref = np.array(bitmap_io(lambda: mi.Bitmap(ref_path)), dtype=np.float64)[..., :3]
         d = (first - ref).reshape(-1, 3)
         mse_c = (d * d).mean(0)
         summary["reference"] = ref_path
@@ -167,7 +191,7 @@ def main():
         summary["rmse"] = float(np.sqrt(mse_c.mean()))
         summary["ref_mean_from_exr"] = [float(x) for x in ref.reshape(-1, 3).mean(0)]
         if os.path.exists(ref_var_path):
-            ref_var = np.array(mi.Bitmap(ref_var_path), dtype=np.float64)[..., :3].reshape(-1, 3)
+            ref_var = np.array(bitmap_io(lambda: mi.Bitmap(ref_var_path)), dtype=np.float64)[..., :3].reshape(-1, 3)
             # The reference's own noise inflates the MSE by its mean variance; take it out.
             summary["rmse_less_ref_noise"] = float(np.sqrt(max(mse_c.mean() - ref_var.mean(), 0.0)))
             # The standard error of this image's mean per channel, predicted from the

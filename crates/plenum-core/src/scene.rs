@@ -757,7 +757,7 @@ impl SceneBuilder {
             .iter()
             .zip(&self.light_spectra)
             .map(|(l, s)| match s {
-                Some((s, scale)) => SpectrumValue::new(s.scaled(*scale), SpectrumKind::Illuminant),
+                Some((s, scale)) => SpectrumValue::new(crate::material::scaled(s, *scale), SpectrumKind::Illuminant),
                 None => SpectrumValue::from_rgb(l.rgb(), SpectrumKind::Illuminant),
             })
             .collect();

@@ -693,6 +693,21 @@ impl<'s> Reader<'s> {
         }
     }
 
+    /// A light's `spectrum`, which replaces its `color` (times its `intensity`).
+    fn light_spectrum(&mut self, f: &Fields<'_, 's>) -> Result<()> {
+        if let Some(v) = f.get("spectrum") {
+            if let Some(c) = f.get("color") {
+                return Err(self
+                    .src
+                    .error(c.span(), "give either `color` or `spectrum`, not both"));
+            }
+            let s = self.spectrum(v)?;
+            let scale = f.non_negative_or("intensity", 1.0)?;
+            self.builder.set_last_light_spectrum(s, scale);
+        }
+        Ok(())
+    }
+
     /// Shadow rays per shading point for an area light: 1 to 1024, 1 by default (more
     /// pixel samples smooth the penumbra just as well).
     fn light_samples(&self, f: &Fields<'_, 's>, key: &str) -> Result<u32> {

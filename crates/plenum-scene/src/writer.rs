@@ -4,7 +4,8 @@
 //! by several objects are written once, as `[meshes.NAME]`.
 
 use crate::RenderDefaults;
-use plenum_core::material::Material;
+use plenum_core::material::{ConductorSpec, FloatTexture, Material, Roughness, SpectralTexture};
+use plenum_spectrum::Spectrum;
 use plenum_core::color::Color;
 use plenum_core::geometry::Shape;
 use plenum_core::light::{Attenuation, Emitter, Light};
@@ -72,7 +73,13 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
     let keys = unique_keys(&scene.material_names, "material");
     for (key, m) in keys.iter().zip(&scene.materials) {
         let _ = writeln!(w, "[materials.{}]", quote(key));
-        let Material::Phong(m) = m;
+        let m = match m {
+            Material::Phong(m) => m,
+            other => {
+                let _ = writeln!(w, "{}", physical_material(other, &keys));
+                continue;
+            }
+        };
         for (name, t) in [
             ("emissive", &m.emissive),
             ("ambient", &m.ambient),
@@ -120,13 +127,9 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
             color(scene.ambient)
         );
     }
-    for (light, name) in scene.lights.iter().zip(&scene.light_names) {
-        if let Light::Area {
-            shape: Emitter::Triangles { .. },
-            ..
-        } = light
-        {
-            // Written as its mesh object, with `emission`.
+    for (i, (light, name)) in scene.lights.iter().zip(&scene.light_names).enumerate() {
+        if written_with_object(scene, i) {
+            // Written as its object, with `emission`.
             continue;
         }
         let _ = writeln!(w, "[[lights]]\nname = {}", quote(name));
@@ -169,6 +172,9 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                     Emitter::Triangles { .. } => Ok(()),
                 };
                 let _ = writeln!(w, "color = {}\nsamples = {samples}\n", color(*radiance));
+            }
+            Light::Infinite { radiance } => {
+                let _ = writeln!(w, "type = \"infinite\"\ncolor = {}\n", color(*radiance));
             }
             Light::Point {
                 position,
@@ -216,19 +222,30 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
         }
     }
     for (index, (p, name)) in scene.primitives.iter().zip(&scene.object_names).enumerate() {
-        let light = shows_light.get(&(index as u32)).map(|&i| &scene.lights[i]);
-        let _ = match light {
-            Some(Light::Area {
-                shape: Emitter::Triangles { .. },
-                radiance,
-                samples,
-                ..
-            }) => writeln!(
-                w,
-                "[[objects]]\nname = {}\nemission = {}\nlight_samples = {samples}",
-                quote(name),
-                color(*radiance)
-            ),
+        let light = shows_light.get(&(index as u32)).copied();
+        let _ = match light.map(|i| (i, &scene.lights[i])) {
+            Some((
+                i,
+                Light::Area {
+                    radiance,
+                    samples,
+                    two_sided,
+                    ..
+                },
+            )) if written_with_object(scene, i) => {
+                let m = &scene.materials[p.material as usize];
+                let material = if m.is_emitter_only() {
+                    String::new()
+                } else {
+                    format!("\nmaterial = {}", quote(&keys[p.material as usize]))
+                };
+                writeln!(
+                    w,
+                    "[[objects]]\nname = {}{material}\nemission = {}\ntwo_sided = {two_sided}\nlight_samples = {samples}",
+                    quote(name),
+                    color(*radiance)
+                )
+            }
             Some(_) => continue,
             None => writeln!(
                 w,
@@ -291,6 +308,111 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
         let _ = writeln!(w);
     }
     out
+}
+
+/// An area light that is written as its object's `emission`: a mesh light, or any object
+/// with a material of its own; the lights of docs/scene-format.md's rectangle, disk and sphere
+/// kind are written as lights.
+fn written_with_object(scene: &Scene, light: usize) -> bool {
+    let Some(prim) = scene.light_objects[light] else {
+        return false;
+    };
+    let emitter_only = scene.materials[scene.primitives[prim as usize].material as usize]
+        .is_emitter_only();
+    let mesh = matches!(scene.primitives[prim as usize].shape, Shape::Mesh(_));
+    mesh || !emitter_only
+}
+
+/// A physically based material's keys (after its `[materials.NAME]` line).
+fn physical_material(m: &Material, keys: &[String]) -> String {
+    let rough = |r: &Roughness| {
+        let f = |t: &FloatTexture| match t {
+            FloatTexture::Constant(v) => format!("{v:?}"),
+            FloatTexture::Texture(t) => texture(t),
+        };
+        format!(
+            "roughness = [{}, {}]\nremap_roughness = {}",
+            f(&r.u),
+            f(&r.v),
+            r.remap
+        )
+    };
+    match m {
+        Material::Phong(_) => String::new(),
+        Material::Diffuse(m) => format!(
+            "type = \"diffuse\"\nreflectance = {}\n",
+            spectral(&m.reflectance)
+        ),
+        Material::Conductor(m) => {
+            let spec = match &m.spec {
+                ConductorSpec::EtaK { eta, k } => {
+                    format!("eta = {}\nk = {}", spectral(eta), spectral(k))
+                }
+                ConductorSpec::Reflectance(r) => format!("reflectance = {}", spectral(r)),
+            };
+            format!("type = \"conductor\"\n{spec}\n{}\n", rough(&m.roughness))
+        }
+        Material::Dielectric(m) => format!(
+            "type = \"dielectric\"\neta = {}\n{}\n",
+            spectrum(m.eta.spectrum()),
+            rough(&m.roughness)
+        ),
+        Material::ThinDielectric(m) => format!(
+            "type = \"thindielectric\"\neta = {}\n",
+            spectrum(m.eta.spectrum())
+        ),
+        Material::DiffuseTransmission(m) => format!(
+            "type = \"diffusetransmission\"\nreflectance = {}\ntransmittance = {}\nscale = {:?}\n",
+            spectral(&m.reflectance),
+            spectral(&m.transmittance),
+            m.scale
+        ),
+        Material::CoatedDiffuse(m) => format!(
+            "type = \"coateddiffuse\"\nreflectance = {}\n{}\neta = {}\nthickness = {:?}\nalbedo = {}\ng = {:?}\nmax_depth = {}\nsamples = {}\n",
+            spectral(&m.reflectance),
+            rough(&m.roughness),
+            spectrum(m.eta.spectrum()),
+            m.thickness,
+            spectral(&m.albedo),
+            m.g,
+            m.max_depth,
+            m.samples
+        ),
+        Material::Mix { materials, amount } => format!(
+            "type = \"mix\"\nmaterials = [{}, {}]\namount = {}\n",
+            quote(&keys[materials[0] as usize]),
+            quote(&keys[materials[1] as usize]),
+            match amount {
+                FloatTexture::Constant(v) => format!("{v:?}"),
+                FloatTexture::Texture(t) => texture(t),
+            }
+        ),
+    }
+}
+
+fn spectral(t: &SpectralTexture) -> String {
+    match t {
+        SpectralTexture::Constant(v) => spectrum(v.spectrum()),
+        SpectralTexture::Rgb { texture: t, .. } => texture(t),
+    }
+}
+
+/// A spectrum: a constant as a number, an uplifted RGB value as its colour, anything else
+/// tabulated every 5 nm over 360–830 nm (names are not kept).
+fn spectrum(s: &Spectrum) -> String {
+    if let Some(rgb) = plenum_core::material::source_rgb(s) {
+        return color(Color::new(rgb[0], rgb[1], rgb[2]));
+    }
+    if s.is_constant() {
+        return format!("{:?}", s.eval(550.0));
+    }
+    let pairs: Vec<String> = (0..=94)
+        .map(|i| {
+            let l = 360.0 + 5.0 * i as f64;
+            format!("[{l:?}, {:?}]", s.eval(l))
+        })
+        .collect();
+    format!("{{ spectrum = [{}] }}", pairs.join(", "))
 }
 
 fn vec(v: Vec3) -> String {

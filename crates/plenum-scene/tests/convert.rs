@@ -16,9 +16,10 @@ fn pixels(l: &LoadedScene) -> Vec<[f32; 3]> {
     let settings = RenderSettings {
         width: 40,
         height: 30,
-        integrator: plenum_core::integrator::WhittedConfig {
+        integrator: plenum_core::integrator::IntegratorConfig {
             max_depth: l.defaults.max_depth,
             min_weight: l.defaults.min_weight,
+            ..Default::default()
         },
         ..Default::default()
     };

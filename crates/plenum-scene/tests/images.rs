@@ -1,7 +1,7 @@
 //! Rendered images checked against values computed by hand from the closed forms.
 
 use plenum_core::camera::Camera;
-use plenum_core::integrator::WhittedConfig;
+use plenum_core::integrator::IntegratorConfig;
 use plenum_core::render::{render, RenderSettings};
 use plenum_core::sampling::PixelSampler;
 use plenum_core::{Color, Vec3};
@@ -18,7 +18,7 @@ fn draw(loaded: &LoadedScene, spp: u32) -> plenum_core::film::Film {
         width: loaded.defaults.width,
         height: loaded.defaults.height,
         sampler: PixelSampler::grid_for(spp),
-        integrator: WhittedConfig::default(),
+        integrator: IntegratorConfig::default(),
         seed: 1,
         corners: false,
         ..Default::default()
@@ -272,7 +272,7 @@ fn image_does_not_depend_on_thread_count() {
         width: 96,
         height: 72,
         sampler: PixelSampler::new(plenum_core::sampling::SamplerKind::Jittered, 4),
-        integrator: WhittedConfig::default(),
+        integrator: IntegratorConfig::default(),
         seed: 42,
         corners: false,
         ..Default::default()

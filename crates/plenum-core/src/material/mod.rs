@@ -10,7 +10,7 @@ mod param;
 mod phong;
 mod physical;
 
-pub use param::{uplift, FloatTexture, SpectralTexture, SpectrumKind, SpectrumValue};
+pub use param::{scaled, source_rgb, uplift, FloatTexture, SpectralTexture, SpectrumKind, SpectrumValue};
 pub use phong::{Coefficients, PhongMaterial};
 pub use physical::{
     CoatedDiffuseMaterial, ConductorMaterial, ConductorSpec, DielectricMaterial,
@@ -110,7 +110,8 @@ impl Material {
                     exponent: k.shininess,
                     kr: s(k.reflective),
                     kt: s(k.transmissive),
-                    eta: if solid { k.ior } else { 1.0 },
+                    eta: k.ior,
+                    thin: !solid,
                     fresnel: k.fresnel,
                 })
             }

@@ -8,7 +8,8 @@
 
 use crate::color::Color;
 use crate::texture::{Texture, TextureCoords};
-use plenum_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
+use plenum_spectrum::uplift::d65_normalized;
+use plenum_spectrum::{RgbToSpectrumTable, SampledSpectrum, SampledWavelengths, Spectrum};
 
 /// How an RGB value becomes a spectrum.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -138,16 +139,71 @@ impl SpectralTexture {
     }
 }
 
-/// An RGB value's spectrum at the sample's wavelengths, through the shared table.
+/// An RGB value's spectrum at the sample's wavelengths, through the shared table (pbrt-v4's
+/// three kinds: the unbounded ones scaled by twice their largest component, illuminants
+/// times D65 of unit luminance).
 pub(crate) fn uplift_at(c: Color, kind: SpectrumKind, wl: &SampledWavelengths) -> SampledSpectrum {
-    plenum_spectrum::uplift_sample([c.r, c.g, c.b], kind_of(kind), wl)
+    let rgb = [c.r.max(0.0), c.g.max(0.0), c.b.max(0.0)];
+    let table = RgbToSpectrumTable::srgb();
+    let (scale, sigmoid) = match kind {
+        SpectrumKind::Albedo => (1.0, table.lookup(rgb)),
+        SpectrumKind::Unbounded | SpectrumKind::Illuminant => {
+            let m = rgb[0].max(rgb[1]).max(rgb[2]);
+            if m == 0.0 {
+                return SampledSpectrum::ZERO;
+            }
+            let scale = 2.0 * m;
+            (scale, table.lookup(rgb.map(|v| v / scale)))
+        }
+    };
+    let mut s = SampledSpectrum::ZERO;
+    for (i, &l) in wl.lambda().iter().enumerate() {
+        s[i] = scale * sigmoid.eval(l);
+        if kind == SpectrumKind::Illuminant {
+            s[i] *= d65_normalized(l);
+        }
+    }
+    s
 }
 
-fn kind_of(kind: SpectrumKind) -> plenum_spectrum::RgbKind {
-    match kind {
-        SpectrumKind::Albedo => plenum_spectrum::RgbKind::Albedo,
-        SpectrumKind::Unbounded => plenum_spectrum::RgbKind::Unbounded,
-        SpectrumKind::Illuminant => plenum_spectrum::RgbKind::Illuminant,
+/// `s` times `k`, as a spectrum of the same kind.
+pub fn scaled(s: &Spectrum, k: f64) -> Spectrum {
+    if k == 1.0 {
+        return s.clone();
+    }
+    match s {
+        Spectrum::Constant(c) => Spectrum::Constant(c * k),
+        Spectrum::Blackbody { kelvin, scale } => Spectrum::blackbody(*kelvin, scale * k),
+        Spectrum::RgbIlluminant { rgb, .. } => Spectrum::rgb_illuminant(rgb.map(|v| v * k)),
+        Spectrum::RgbAlbedo { rgb, .. } | Spectrum::RgbUnbounded { rgb, .. } => {
+            Spectrum::rgb_unbounded(rgb.map(|v| v * k))
+        }
+        Spectrum::PiecewiseLinear(p) => {
+            let pairs: Vec<(f64, f64)> = p
+                .wavelengths()
+                .iter()
+                .zip(p.values())
+                .map(|(&l, &v)| (l, v * k))
+                .collect();
+            let made = if p.is_illuminant() {
+                Spectrum::piecewise_illuminant(&pairs)
+            } else {
+                Spectrum::piecewise(&pairs)
+            };
+            made.unwrap_or_else(|_| s.clone())
+        }
+        // Dispersion formulas are indices, never scaled.
+        other => other.clone(),
+    }
+}
+
+/// The RGB value an uplifted spectrum came from, if it is one.
+pub fn source_rgb(s: &Spectrum) -> Option<[f64; 3]> {
+    match s {
+        Spectrum::RgbAlbedo { rgb, .. }
+        | Spectrum::RgbUnbounded { rgb, .. }
+        | Spectrum::RgbIlluminant { rgb, .. } => Some(*rgb),
+        _ => None,
     }
 }
 

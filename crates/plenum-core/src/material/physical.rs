@@ -164,15 +164,14 @@ impl CoatedDiffuseMaterial {
         let r = self.reflectance.evaluate(at, wl).map(|v| v.clamp(0.0, 1.0));
         let albedo = self.albedo.evaluate(at, wl).map(|v| v.clamp(0.0, 1.0));
         let eta = eta_at(&self.eta, wl);
-        Bxdf::CoatedDiffuse(CoatedDiffuseBxdf::new(
-            self.roughness.distribution(at),
-            eta,
-            r,
-            self.thickness,
+        Bxdf::CoatedDiffuse(CoatedDiffuseBxdf {
+            top: DielectricBxdf::new(eta, self.roughness.distribution(at)),
+            bottom: DiffuseBxdf::new(r),
+            thickness: self.thickness,
             albedo,
-            self.g,
-            self.max_depth,
-            self.samples,
-        ))
+            g: self.g,
+            max_depth: self.max_depth,
+            samples: self.samples,
+        })
     }
 }

@@ -40,9 +40,10 @@ impl<'s> Reader<'s> {
     ) -> Result<Option<Material>> {
         let what = format!("{kind} material `{name}`");
         let rough_keys = ["roughness", "remap_roughness"];
-        let table = |keys: &[&str]| {
-            let all: Vec<&str> = ["type"].iter().chain(keys).copied().collect();
-            self.src.table(v, &what, &all)
+        let src = self.src;
+        let table = |keys: &[&'static str]| {
+            let all: Vec<&'static str> = ["type"].iter().chain(keys).copied().collect();
+            src.table(v, &what, &all)
         };
         Ok(Some(match kind {
             "diffuse" => {
@@ -305,7 +306,7 @@ impl<'s> Reader<'s> {
                 let f = self.src.table(v, "a spectrum", &["blackbody", "spectrum"])?;
                 if f.get("blackbody").is_some() {
                     let t = f.positive("blackbody", None)?;
-                    return Ok(Spectrum::blackbody(t));
+                    return Ok(Spectrum::blackbody(t, 1.0));
                 }
                 let list = f.required("spectrum")?;
                 let items = self.src.array(list, "[wavelength in nm, value] pairs")?;

@@ -1,0 +1,344 @@
+//! The path tracer against closed forms and an independent renderer: pbrt-v4's analytic
+//! furnace scenes (every pixel's radiance is 1), dispersion through a prism against Snell's
+//! law, Mitsuba 3's converged Cornell box by a per-pixel z-test, and the same image for any
+//! thread count.
+
+use plenum_core::bxdf::TransportMode;
+use plenum_core::integrator::{ColorMode, IntegratorConfig, IntegratorKind};
+use plenum_core::math::Ray;
+use plenum_core::render::{render, RenderSettings};
+use plenum_core::sampling::{PixelSampler, SamplerKind};
+use plenum_core::Vec3;
+use plenum_scene::{load_scene, parse_scene, LoadedScene};
+use plenum_spectrum::SampledWavelengths;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+fn scene(text: &str) -> LoadedScene {
+    parse_scene(Path::new("test.toml"), text, Path::new(".")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn path_settings(l: &LoadedScene, spp: u32, color: ColorMode, seed: u64) -> RenderSettings {
+    RenderSettings {
+        width: l.defaults.width,
+        height: l.defaults.height,
+        sampler: PixelSampler::new(SamplerKind::Random, spp),
+        integrator: IntegratorConfig {
+            kind: IntegratorKind::Path,
+            max_depth: l.defaults.max_depth,
+            rr_depth: l.defaults.rr_depth,
+            color,
+            ..Default::default()
+        },
+        seed,
+        ..Default::default()
+    }
+}
+
+fn draw(l: &LoadedScene, settings: &RenderSettings) -> Vec<[f32; 3]> {
+    let out = render(&l.scene, settings, &AtomicBool::new(false), &|_, _| {});
+    assert_eq!(out.counts.invalid, 0, "no sample may come out NaN or infinite");
+    out.film.pixels().to_vec()
+}
+
+fn mean(pixels: &[[f32; 3]]) -> [f64; 3] {
+    let mut m = [0.0; 3];
+    for p in pixels {
+        for c in 0..3 {
+            m[c] += p[c] as f64;
+        }
+    }
+    m.map(|v| v / pixels.len() as f64)
+}
+
+/// The camera inside a sphere of radius 1 and reflectance 0.5: pbrt-v4's analytic scenes.
+fn furnace(light: &str, sphere_emission: &str) -> String {
+    format!(
+        r#"
+[render]
+max_depth = 100
+rr_depth = 5
+
+[camera]
+position = [0, 0, 0]
+look_at = [0, 0, -1]
+fov = 90
+resolution = [12, 12]
+
+[materials.half]
+type = "diffuse"
+reflectance = 0.5
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "half"
+{sphere_emission}
+
+{light}
+"#
+    )
+}
+
+/// L = ρ/π·E + ρ·L with E = I/r² = π from the point light(s), or L = L_e + ρ·L for an
+/// emitting sphere: both give L = 1. At 256 spp the image mean must be within ±0.01
+/// (Russian roulette, unbiased; the standard error of the mean here is below 0.003).
+#[test]
+fn furnace_scenes_converge_to_radiance_one() {
+    let pi = std::f64::consts::PI;
+    let quarter = pi / 4.0;
+    let cases = [
+        (
+            "a central point light of intensity π",
+            format!("[[lights]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = {pi}"),
+            String::new(),
+        ),
+        (
+            "four point lights of intensity π/4",
+            [[0.1, 0.0, 0.0], [-0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, -0.1, 0.0]]
+                .iter()
+                .map(|p| {
+                    format!(
+                        "[[lights]]\ntype = \"point\"\nposition = {p:?}\nintensity = {quarter}\n"
+                    )
+                })
+                .collect(),
+            String::new(),
+        ),
+        (
+            "the sphere's own emission 0.5",
+            String::new(),
+            "emission = [0.5, 0.5, 0.5]".to_string(),
+        ),
+    ];
+    for (what, light, emission) in cases {
+        let l = scene(&furnace(&light, &emission));
+        for color in [ColorMode::Rgb, ColorMode::Spectral] {
+            let m = mean(&draw(&l, &path_settings(&l, 256, color, 3)));
+            for (c, v) in m.iter().enumerate() {
+                assert!(
+                    (v - 1.0).abs() <= 0.01,
+                    "{what}, {color:?}: channel {c} has mean {v}, expected 1 ± 0.01"
+                );
+            }
+        }
+    }
+}
+
+/// Dense flint glass (N-SF5-class, Sellmeier) as a 60° prism: a ray of each wavelength
+/// refracted in and out through the material's BSDF leaves at the angle that Snell's law and
+/// the glass's dispersion formula give, and only the hero wavelength goes on.
+#[test]
+fn a_prism_disperses_by_snells_law() {
+    let l = scene(
+        r#"
+[camera]
+position = [0, 0, 10]
+look_at = [0, 0, 0]
+
+[materials.flint]
+type = "dielectric"
+eta = "dense-flint"
+
+[[objects]]
+type = "polyhedron"
+material = "flint"
+vertices = [[-1, -0.57735027, -1], [1, -0.57735027, -1], [0, 1.15470054, -1],
+            [-1, -0.57735027, 1], [1, -0.57735027, 1], [0, 1.15470054, 1]]
+faces = [[0, 2, 1], [3, 4, 5], [0, 1, 4, 3], [1, 2, 5, 4], [2, 0, 3, 5]]
+"#,
+    );
+    let s = &l.scene;
+    let eta = plenum_spectrum::named("dense-flint").expect("dense flint is named");
+    // The beam meets the left face at 50° from its normal, in the plane z = 0.
+    let left_normal = Vec3::new(-0.8660254037844386, 0.5, 0.0);
+    let incidence = 50f64.to_radians();
+    let into = -left_normal;
+    let tangent = Vec3::new(0.5, 0.8660254037844386, 0.0);
+    let d0 = (into * incidence.cos() + tangent * incidence.sin()).normalized();
+    let mut exits = Vec::new();
+    for lambda in [450.0, 550.0, 650.0] {
+        let mut wl = SampledWavelengths::from_parts(
+            [lambda, lambda + 100.0, lambda + 200.0, lambda + 300.0],
+            [1.0; 4],
+        );
+        let mut ray = Ray::new(Vec3::new(-0.5, 0.2886751345948129, 0.0) - d0 * 2.0, d0);
+        for interface in 0..2 {
+            let (prim, hit) = s.intersect(&ray, f64::INFINITY).expect("the beam meets the prism");
+            let it = s.interaction(&ray, prim, &hit);
+            let wo = -ray.direction.normalized();
+            let bsdf = s.bsdf(&it, wo, &mut wl).expect("glass scatters");
+            // u close to 1 chooses transmission (reflection takes u < R/(R+T)).
+            let bs = bsdf
+                .sample_f(wo, 0.999_999, [0.5, 0.5], TransportMode::Radiance)
+                .expect("the beam is transmitted");
+            assert!(bs.is_transmission(), "interface {interface} at {lambda} nm");
+            let origin = plenum_core::math::offset_ray_origin(it.p, it.p_error, it.n, bs.wi);
+            ray = Ray::new(origin, bs.wi);
+        }
+        assert!(wl.secondary_terminated(), "dispersion keeps only the hero wavelength");
+        // Snell twice: in at 50° on the left face, out through the right face (apex 60°).
+        let n = eta.eval(lambda);
+        let inside = (incidence.sin() / n).asin();
+        let at_exit = 60f64.to_radians() - inside;
+        let out = (n * at_exit.sin()).asin();
+        let right_normal = Vec3::new(0.8660254037844386, 0.5, 0.0);
+        let got = ray.direction.normalized().dot(right_normal).acos();
+        assert!(
+            (got - out).abs() < 1e-9,
+            "{lambda} nm: left the prism at {:.9}°, Snell's law gives {:.9}°",
+            got.to_degrees(),
+            out.to_degrees()
+        );
+        exits.push(got);
+    }
+    // Blue bends most.
+    assert!(exits[0] > exits[1] && exits[1] > exits[2], "{exits:?}");
+}
+
+fn cbox_reference(file: &str) -> Option<PathBuf> {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/references/cbox")
+        .join(file);
+    p.exists().then_some(p)
+}
+
+fn read_exr(p: &Path) -> Vec<[f32; 3]> {
+    plenum_image::read_float_image(p)
+        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+        .pixels
+}
+
+/// Mitsuba 3's image test on the Cornell box: `renders` independent renders of `spp` samples
+/// give each pixel channel a mean and the variance of that mean; z = |mean − ref| /
+/// √(var + var_ref); a channel passes when 2(1 − Φ(z)) > α = 1 − 0.99^(1/N). At least 99.75 %
+/// must pass, and the squared error must be what the two variances predict (its ratio to
+/// them within 0.8–1.25).
+fn cbox_z_test(color: ColorMode, reference: &str, variance: &str) {
+    let (Some(r), Some(v)) = (cbox_reference(reference), cbox_reference(variance)) else {
+        eprintln!("../shared/data/references/cbox is not here: the Cornell box z-test has nothing to compare with");
+        return;
+    };
+    let (reference, ref_var) = (read_exr(&r), read_exr(&v));
+    let scene_file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
+    let l = load_scene(&scene_file).unwrap_or_else(|e| panic!("{e}"));
+    let (renders, spp) = (8u64, 32);
+    let images: Vec<Vec<[f32; 3]>> = (0..renders)
+        .map(|seed| draw(&l, &path_settings(&l, spp, color, 1000 + seed)))
+        .collect();
+    assert_eq!(images[0].len(), reference.len());
+    let n = (reference.len() * 3) as f64;
+    let alpha = 1.0 - 0.99f64.powf(1.0 / n);
+    let z_max = normal_quantile(1.0 - alpha / 2.0);
+    let (mut pass, mut squared, mut predicted) = (0usize, 0.0, 0.0);
+    for i in 0..reference.len() {
+        for c in 0..3 {
+            let xs: Vec<f64> = images.iter().map(|im| im[i][c] as f64).collect();
+            let m = xs.iter().sum::<f64>() / renders as f64;
+            let var = xs.iter().map(|x| (x - m).powi(2)).sum::<f64>()
+                / ((renders - 1) * renders) as f64;
+            let d = m - reference[i][c] as f64;
+            let total = var + ref_var[i][c] as f64;
+            if total == 0.0 && d == 0.0 || d.abs() <= z_max * total.sqrt() {
+                pass += 1;
+            }
+            squared += d * d;
+            predicted += total;
+        }
+    }
+    let rate = pass as f64 / n;
+    let ratio = squared / predicted;
+    eprintln!(
+        "Cornell box, {color:?}, {} spp: {:.4} % of pixel channels pass (z ≤ {z_max:.2}); squared error / predicted = {ratio:.3}",
+        renders * spp as u64,
+        100.0 * rate
+    );
+    assert!(rate >= 0.9975, "only {:.3} % passed", 100.0 * rate);
+    assert!((0.8..=1.25).contains(&ratio), "squared error is {ratio} × what noise predicts");
+}
+
+/// Φ⁻¹(p) by bisection on the complementary error function's series (erfc from
+/// Numerical Recipes' Chebyshev fit, relative error < 1.2e-7).
+fn normal_quantile(p: f64) -> f64 {
+    let erfc = |x: f64| {
+        let z = x.abs();
+        let t = 1.0 / (1.0 + 0.5 * z);
+        let r = t * (-z * z - 1.26551223
+            + t * (1.00002368
+                + t * (0.37409196
+                    + t * (0.09678418
+                        + t * (-0.18628806
+                            + t * (0.27886807
+                                + t * (-1.13520398
+                                    + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
+            .exp();
+        if x >= 0.0 {
+            r
+        } else {
+            2.0 - r
+        }
+    };
+    let cdf = |x: f64| 1.0 - 0.5 * erfc(x / std::f64::consts::SQRT_2);
+    let (mut lo, mut hi) = (-40.0, 40.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if cdf(mid) < p {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+#[test]
+fn cornell_box_matches_mitsuba_in_rgb() {
+    cbox_z_test(ColorMode::Rgb, "reference.exr", "reference-variance.exr");
+}
+
+#[test]
+fn cornell_box_matches_mitsuba_spectrally() {
+    cbox_z_test(
+        ColorMode::Spectral,
+        "reference-spectral.exr",
+        "reference-spectral-variance.exr",
+    );
+}
+
+/// The same path-traced image, bit for bit, with 1 and 2 threads, in both colour modes.
+#[test]
+fn path_traced_image_does_not_depend_on_thread_count() {
+    let l = scene(&furnace(
+        "[[lights]]\ntype = \"point\"\nposition = [0.2, 0.1, 0]\nintensity = 3",
+        "",
+    ));
+    for color in [ColorMode::Rgb, ColorMode::Spectral] {
+        let settings = path_settings(&l, 4, color, 9);
+        let films: Vec<Vec<[f32; 3]>> = [1, 2]
+            .iter()
+            .map(|&n| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .unwrap()
+                    .install(|| draw(&l, &settings))
+            })
+            .collect();
+        assert_eq!(films[0], films[1], "{color:?}");
+    }
+}
+
+/// Every Whitted scene also renders under the path tracer, its Phong materials read as a
+/// normalised BSDF: the built-in scene gives a finite, lit image.
+#[test]
+fn phong_scenes_render_under_the_path_tracer() {
+    let mut l = plenum_scene::builtin_scene();
+    l.defaults.width = 32;
+    l.defaults.height = 24;
+    for color in [ColorMode::Rgb, ColorMode::Spectral] {
+        let pixels = draw(&l, &path_settings(&l, 4, color, 5));
+        let m = mean(&pixels);
+        assert!(m.iter().all(|v| v.is_finite() && *v > 0.01), "{color:?}: mean {m:?}");
+    }
+}
