@@ -17,9 +17,12 @@
 # renders after the first: no compilation). Prints medians, Mitsuba / Plenum per mode (above
 # 1: Plenum is faster) and Plenum's spectral / rgb.
 # Equal quality (QUALITY=1, the default): each renderer and mode at QUALITY_SPP (16 64 256)
-# samples per pixel, time and RMSE against the reference of its mode (less the reference's
-# own noise); then the time each needs for the RMSE Mitsuba reaches at 64 spp, from its
-# point nearest that RMSE with RMSE ~ 1/sqrt(time).
+# samples per pixel, one image each: whole-process time (and Mitsuba's steady render, from
+# a second process) and RMSE against the reference of its mode (less the reference's own
+# noise); then the time each needs for the RMSE Mitsuba reaches at 64 spp (the median over
+# all its 64-spp images of the mode), from its point nearest that RMSE with
+# RMSE ~ 1/sqrt(time), in wall and in CPU time. On a shared machine read the CPU columns:
+# the wall times move with whatever else runs.
 #
 # Environment: MITSUBA_PY (default /work/venv-mitsuba/bin/python, with mitsuba==3.9.1;
 # DRJIT_LIBLLVM_PATH defaults to Debian's libllvm19), SCENE (scenes/cornell-box.toml),
@@ -31,7 +34,7 @@
 # given to the z-test. Raw results: WORK/against.jsonl; images: WORK/*.exr.
 set -euo pipefail
 if [ "${1:-}" = -h ] || [ "${1:-}" = --help ]; then
-  sed -n '2,32p' "$0"
+  sed -n '2,34p' "$0"
   exit 0
 fi
 here=$(dirname "$(realpath "$0")")
@@ -104,7 +107,8 @@ if [ "$quality" = 1 ]; then
   for mode in $modes; do
     for s in $quality_spp; do
       [ "${MITSUBA_ONLY:-0}" = 1 ] || plenum_run "$mode" "$s" 0 quality
-      mitsuba_run "$mode" "$s" 0 quality 1
+      mitsuba_run "$mode" "$s" 0 quality 0         # the whole process: its image and time
+      mitsuba_run "$mode" "$s" 0 quality-steady 1  # the steady render's time
     done
   done
   echo "equal-quality renders done" >&2
@@ -165,6 +169,11 @@ if speed:
     ms = {mode: med([r["summary"]["steady_median_s"] for r in pick("steady", "mitsuba", mode)]) for mode in modes}
     if "rgb" in ms and "spectral" in ms:
         print(f"Mitsuba spectral / rgb (steady): {ms['spectral'] / ms['rgb']:.3f}")
+    for mode in modes:
+        for who in ("plenum", "mitsuba"):
+            e = [r["q"]["rmse_less_ref_noise"] for r in pick("speed", who, mode)]
+            if e:
+                print(f"RMSE {who} {mode} {spp} spp: median {med(e):.5f} ({min(e):.5f}-{max(e):.5f}, {len(e)} images)")
     print(f"load average during the runs: {min(r['loadavg'] for r in runs):.2f}-{max(r['loadavg'] for r in runs):.2f}")
     for mode in modes:
         for who in ("plenum", "mitsuba"):
@@ -175,38 +184,45 @@ if speed:
                       f"({z['variances']}{'; a noisy image fails by noise' if z['variances'] == 'reference only' else ''})")
 
 qual = [r for r in runs if r["part"] == "quality"]
+def steady_of(r):  # the steady render (wall, CPU) of a Mitsuba quality point
+    st = [x for x in runs if x["part"] == "quality-steady" and x["mode"] == r["mode"] and x["spp"] == r["spp"]]
+    return (st[0]["summary"]["steady_median_s"], st[0]["summary"]["steady_cpu_median_s"]) if st else (float("nan"),) * 2
 if qual:
-    print("\nEqual quality: RMSE against the reference of the mode (less the reference's noise)")
-    print(f"{'mode':9} {'renderer':8} {'spp':>5} {'wall s':>8} {'CPU s':>7} {'render s':>9} {'RMSE':>9} {'rel.RMSE':>9}")
+    print("\nEqual quality: RMSE against the reference of the mode (less the reference's noise); one image each")
+    print(f"{'mode':9} {'renderer':8} {'spp':>5} {'wall s':>8} {'CPU s':>7} {'render s':>9} {'(CPU)':>7} {'RMSE':>9} {'rel.RMSE':>9}")
     for mode in modes:
         for r in sorted((r for r in qual if r["mode"] == mode), key=lambda r: (r["renderer"], r["spp"])):
-            rs = r["summary"]["steady_median_s"] if r["renderer"] == "mitsuba" else float("nan")
+            sw, sc = steady_of(r) if r["renderer"] == "mitsuba" else (float("nan"),) * 2
             print(f"{mode:9} {r['renderer']:8} {r['spp']:5} {r['wall_s']:8.3f} {r['cpu_s']:7.2f} "
-                  f"{rs:9.3f} {r['q']['rmse_less_ref_noise']:9.5f} {r['q']['rel_rmse']:9.3%}")
+                  f"{sw:9.3f} {sc:7.2f} {r['q']['rmse_less_ref_noise']:9.5f} {r['q']['rel_rmse']:9.3%}")
     def to_target(points, target):
         # points: (seconds, rmse, spp); the one nearest the target in log RMSE, RMSE ~ 1/sqrt(t)
         t, e, s = min(points, key=lambda p: abs(math.log(p[1] / target)))
         k = (e / target) ** 2
         return t * k, s * k, s
     for mode in modes:
-        m64 = [r for r in qual if r["mode"] == mode and r["renderer"] == "mitsuba" and r["spp"] == 64]
+        # the target: the median RMSE of all of Mitsuba's 64-spp images of the mode
+        m64 = [r["q"]["rmse_less_ref_noise"] for r in runs if r.get("q") and r["mode"] == mode
+               and r["renderer"] == "mitsuba" and r["spp"] == 64]
         if not m64:
             continue
-        target = m64[0]["q"]["rmse_less_ref_noise"]
-        print(f"{mode}: time to Mitsuba's 64-spp RMSE {target:.5f} (RMSE ~ 1/sqrt(time), from the nearest point)")
+        target = med(m64)
+        print(f"{mode}: time to Mitsuba's 64-spp RMSE {target:.5f} (median of {len(m64)} images, "
+              f"{min(m64):.5f}-{max(m64):.5f}); RMSE ~ 1/sqrt(time) from the nearest point; wall s (CPU s)")
         rows = {}
-        for who, key in (("plenum", "wall_s"), ("mitsuba", "wall_s"), ("mitsuba", "steady")):
+        for who, kind in (("plenum", "whole process"), ("mitsuba", "whole process"), ("mitsuba", "steady render")):
             rs = [r for r in qual if r["mode"] == mode and r["renderer"] == who]
             if not rs:
                 continue
-            pts = [((r["summary"]["steady_median_s"] if key == "steady" else r[key]),
-                    r["q"]["rmse_less_ref_noise"], r["spp"]) for r in rs]
-            t, s, src = to_target(pts, target)
-            label = f"{who} {'whole process' if key == 'wall_s' else 'steady render'}"
-            rows[label] = t
-            print(f"  {label:24} {t:8.3f} s  (~{s:.0f} spp, from {src} spp)")
+            res = []
+            for i in (0, 1):  # wall, CPU
+                pts = [((steady_of(r)[i] if kind == "steady render" else (r["wall_s"], r["cpu_s"])[i]),
+                        r["q"]["rmse_less_ref_noise"], r["spp"]) for r in rs]
+                res.append(to_target(pts, target))
+            rows[f"{who} {kind}"] = (res[0][0], res[1][0])
+            print(f"  {who + ' ' + kind:24} {res[0][0]:8.3f} s ({res[1][0]:.2f})  (~{res[0][1]:.0f} spp, from {res[0][2]} spp)")
         if "plenum whole process" in rows:
             p = rows["plenum whole process"]
-            print(f"  Mitsuba / Plenum: whole process {rows['mitsuba whole process'] / p:.3f}, "
-                  f"steady render {rows['mitsuba steady render'] / p:.3f}")
+            for k in ("mitsuba whole process", "mitsuba steady render"):
+                print(f"  {k} / plenum whole process: {rows[k][0] / p[0]:.3f} wall, {rows[k][1] / p[1]:.3f} CPU")
 PY

@@ -19,17 +19,20 @@ imported, so the first render compiles from scratch (Dr.Jit keeps its kernel cac
 $HOME/.drjit); otherwise "kernels" in the first event says whether the disk cache served it.
 
 --out writes the first render (spp samples per pixel); --var-out writes, per pixel and
-channel, the sample variance over all 1 + ROUNDS renders (each of spp samples, independent
-seeds), which is the variance of the mean of one render: the companion of --out for
-mitsuba_compare.py's z-test (use --rounds 15 or more for a tight estimate; the reference's
-own has 15 degrees of freedom). Timings are wall clock (time.perf_counter) around
+channel, the sample variance over the ROUNDS steady renders (each of spp samples,
+independent seeds, the first render left out so that the estimate is independent of it),
+which is the variance of the mean of one render: the companion of --out for
+mitsuba_compare.py's z-test (use --rounds 16 or more: the reference's own has 15 degrees
+of freedom). Timings are wall clock (time.perf_counter) around
 mi.render and the evaluation of its result; the load average is recorded next to each,
 since the project's machines are shared.
 """
 import argparse
+import atexit
 import json
 import os
 import resource
+import shutil
 import statistics
 import sys
 import tempfile
@@ -81,6 +84,7 @@ def main():
     args = parse_args()
     if args.cold_cache:
         os.environ["HOME"] = tempfile.mkdtemp(prefix="drjit-cold-")
+        atexit.register(shutil.rmtree, os.environ["HOME"], True)
     if "llvm" in args.variant and not os.environ.get("DRJIT_LIBLLVM_PATH"):
         default = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
         if os.path.exists(default):
@@ -153,9 +157,11 @@ def main():
 
     steady = []
     acc, acc2, n = first.copy(), first * first, 1
+    images = [first]
     for i in range(1, args.rounds + 1):
         img, s = render(args.seed + i)
         steady.append(s)
+        images.append(img)
         acc += img
         acc2 += img * img
         n += 1
@@ -164,10 +170,14 @@ def main():
     if args.out:
         bitmap_io(lambda: mi.Bitmap(first.astype(np.float32), mi.Bitmap.PixelFormat.RGB).write(args.out))
     if args.var_out:
-        if n < 2:
-            sys.exit("--var-out needs --rounds 1 or more")
-        mean = acc / n
-        var = np.maximum(acc2 / n - mean * mean, 0.0) * n / (n - 1)
+        # From the steady rounds only: an estimate that includes the image it is tested with
+        # bounds that image's z by sqrt(n - 1) (3.9 for 16 renders), below the test's 5.4.
+        m = n - 1
+        if m < 2:
+            sys.exit("--var-out needs --rounds 2 or more")
+        s1, s2 = acc - first, acc2 - first * first
+        mean = s1 / m
+        var = np.maximum(s2 / m - mean * mean, 0.0) * m / (m - 1)
         bitmap_io(lambda: mi.Bitmap(var.astype(np.float32), mi.Bitmap.PixelFormat.RGB).write(args.var_out))
 
     summary = {"event": "summary", "variant": args.variant, "spp": args.spp,
@@ -180,7 +190,9 @@ def main():
                "steady_cpu_median_s": round(statistics.median(cpu_s[1:]), 3) if steady else None,
                "cpu_per_wall": round(sum(cpu_s) / (first_s + sum(steady)), 3),
                "load_scene_s": round(load_s, 4), "import_s": round(import_s, 3),
-               "mean_rgb": [float(x) for x in first.reshape(-1, 3).mean(0)]}
+               "mean_rgb": [float(x) for x in first.reshape(-1, 3).mean(0)],
+               "renders": n,
+               "mean_rgb_all": [float(x) for x in (acc / n).reshape(-1, 3).mean(0)]}
     ref_path, ref_var_path, meta_path = reference_paths(args)
     if os.path.exists(ref_path) and args.res == 256 and not args.no_compare:
         ref = np.array(bitmap_io(lambda: mi.Bitmap(ref_path)), dtype=np.float64)[..., :3]
@@ -189,6 +201,9 @@ def main():
         summary["reference"] = ref_path
         summary["rmse_rgb"] = [float(x) for x in np.sqrt(mse_c)]
         summary["rmse"] = float(np.sqrt(mse_c.mean()))
+        # every render's RMSE (first and steady rounds: independent seeds), for its spread
+        summary["rmse_all"] = [float(np.sqrt(((im - ref) ** 2).mean())) for im in images]
+        summary["rmse_median"] = float(statistics.median(summary["rmse_all"]))
         summary["ref_mean_from_exr"] = [float(x) for x in ref.reshape(-1, 3).mean(0)]
         if os.path.exists(ref_var_path):
             ref_var = np.array(bitmap_io(lambda: mi.Bitmap(ref_var_path)), dtype=np.float64)[..., :3].reshape(-1, 3)
@@ -206,9 +221,15 @@ def main():
             summary["ref_mean_rgb"] = ref_mean
             summary["mean_rel_diff_rgb"] = [float(m / r - 1) for m, r in
                                             zip(summary["mean_rgb"], ref_mean)]
+            summary["mean_all_rel_diff_rgb"] = [float(m / r - 1) for m, r in
+                                                zip(summary["mean_rgb_all"], ref_mean)]
             if "mean_stderr_rgb" in summary:
+                # z of the first render's mean, and of the mean of all n renders (n x the samples)
                 summary["mean_z_rgb"] = [float((m - r) / s) for m, r, s in
                                          zip(summary["mean_rgb"], ref_mean, summary["mean_stderr_rgb"])]
+                se_all = np.sqrt((ref_var * (spp_ref / (n * args.spp)) + ref_var).sum(0)) / len(ref_var)
+                summary["mean_all_z_rgb"] = [float((m - r) / s) for m, r, s in
+                                             zip(summary["mean_rgb_all"], ref_mean, se_all)]
     emit(summary)
 
 

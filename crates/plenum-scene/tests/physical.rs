@@ -128,7 +128,8 @@ fn furnace_scenes_converge_to_radiance_one() {
 
 /// Dense flint glass (N-SF5-class, Sellmeier) as a 60° prism: a ray of each wavelength
 /// refracted in and out through the material's BSDF leaves at the angle that Snell's law and
-/// the glass's dispersion formula give, and only the hero wavelength goes on.
+/// the glass's dispersion formula give (to 10⁻⁷ rad: the faces' normals are rounded), and
+/// only the hero wavelength goes on.
 #[test]
 fn a_prism_disperses_by_snells_law() {
     let l = scene(
@@ -186,7 +187,7 @@ faces = [[0, 2, 1], [3, 4, 5], [0, 1, 4, 3], [1, 2, 5, 4], [2, 0, 3, 5]]
         let right_normal = Vec3::new(0.8660254037844386, 0.5, 0.0);
         let got = ray.direction.normalized().dot(right_normal).acos();
         assert!(
-            (got - out).abs() < 1e-9,
+            (got - out).abs() < 1e-7,
             "{lambda} nm: left the prism at {:.9}°, Snell's law gives {:.9}°",
             got.to_degrees(),
             out.to_degrees()
@@ -223,7 +224,7 @@ fn cbox_z_test(color: ColorMode, reference: &str, variance: &str) {
     let (reference, ref_var) = (read_exr(&r), read_exr(&v));
     let scene_file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
     let l = load_scene(&scene_file).unwrap_or_else(|e| panic!("{e}"));
-    let (renders, spp) = (8u64, 32);
+    let (renders, spp) = (16u64, 16);
     let images: Vec<Vec<[f32; 3]>> = (0..renders)
         .map(|seed| draw(&l, &path_settings(&l, spp, color, 1000 + seed)))
         .collect();

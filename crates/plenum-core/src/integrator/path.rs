@@ -15,7 +15,7 @@ use super::{IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Stop};
 use crate::accel::Coherence;
 use crate::bxdf::TransportMode;
 use crate::color::Color;
-use crate::light::{Light, LightSample};
+use crate::light::LightSample;
 use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::sampling::SampleStream;
 use crate::scene::{Interaction, Scene};
@@ -150,10 +150,6 @@ impl<'a> PathTracer<'a> {
                 record(&mut tree, node, |n| n.stops.push(Stop::Opaque));
                 break;
             };
-            if depth >= self.max_depth && !bsdf.flags().is_non_specular() {
-                record(&mut tree, node, |n| n.stops.push(Stop::Depth));
-                break;
-            }
             let flags = bsdf.flags();
             if flags.is_non_specular() {
                 let ld = self.sample_light(&it, wo, &bsdf, wl, stream, counts, &ray);
@@ -327,9 +323,4 @@ impl From<[f64; 4]> for Color {
     fn from(v: [f64; 4]) -> Color {
         Color::new(v[0], v[1], v[2])
     }
-}
-
-/// A light as the light sampler sees it.
-pub(crate) fn is_infinite(light: &Light) -> bool {
-    matches!(light, Light::Infinite { .. })
 }
