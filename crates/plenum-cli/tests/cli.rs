@@ -193,9 +193,36 @@ fn bad_scenes_give_located_errors() {
         ),
         ("[materials.m]\ngloss = 0\n", "2:9", "positive"),
         (
-            "[materials.x]\n[[objects]]\ntype = \"mesh\"\npositions = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\nindices = [[0, 1, 2]]\nemission = 1\nmaterial = \"x\"\n",
+            "[[objects]]\ntype = \"cylinder\"\nbase = [0, 0, 0]\ntop = [0, 1, 0]\nradius = 1\nemission = 1\n",
             "6:12",
-            "drop `material`",
+            "cannot be an area light",
+        ),
+        (
+            "[materials.gold]\ntype = \"conductor\"\nmetal = \"Gold\"\n",
+            "3:9",
+            "unknown metal `Gold`",
+        ),
+        (
+            "[materials.glass]\ntype = \"dielectric\"\neta = \"glass-BK8\"\n",
+            "3:7",
+            "did you mean `glass-BK7`?",
+        ),
+        (
+            "[materials.m]\ntype = \"difuse\"\n",
+            "2:8",
+            "did you mean `diffuse`?",
+        ),
+        (
+            "[materials.m]\ntype = \"diffuse\"\nroughness = 0.5\n",
+            "3:1",
+            "unknown field `roughness`",
+        ),
+        ("[render]\nintegrator = \"photon\"\n", "2:14", "unknown integrator"),
+        ("[render]\ncolor = \"hsv\"\n", "2:9", "unknown colour mode"),
+        (
+            "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nspectrum = { spectrum = [[500, 1], [400, 2]] }\n",
+            "4:25",
+            "not increasing",
         ),
     ];
     for (i, (text, location, message)) in cases.iter().enumerate() {

@@ -441,7 +441,7 @@ mod tests {
         // Pixel centres span 45°: the edge-to-edge angle is wider by 64/63.
         let want = 2.0 * ((22.5f64.to_radians().tan() * 64.0 / 63.0).atan()).to_degrees();
         assert!((scene.camera.fov_degrees - want).abs() < 1e-12);
-        let m = &scene.materials[0];
+        let m = scene.materials[0].phong().unwrap();
         assert!(matches!(m.reflective, Texture::Constant(c) if c == Color::gray(0.2)));
     }
 

@@ -66,6 +66,14 @@ impl Material {
         Material::Phong(PhongMaterial::emitter(radiance))
     }
 
+    /// The Phong model's parameters, if this is one.
+    pub fn phong(&self) -> Option<&PhongMaterial> {
+        match self {
+            Material::Phong(m) => Some(m),
+            _ => None,
+        }
+    }
+
     /// A Phong material that only shows emitted light (an emitter's surface).
     pub fn is_emitter_only(&self) -> bool {
         match self {
