@@ -9,7 +9,9 @@
 //! gives, ∫ L_e cos θ dω, which falls off with the square of the distance.
 
 use crate::color::Color;
+use crate::environment::EnvironmentMap;
 use crate::geometry::Shape;
+use std::sync::Arc;
 use crate::math::{Transform, Vec3};
 use crate::sampling::{
     concentric_disk, uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_triangle, Frame,
@@ -77,6 +79,30 @@ pub enum Light {
     /// Radiance `radiance` arriving from every direction at infinity (physically based
     /// integrators only; Whitted's scenes have their `background`).
     Infinite { radiance: Color },
+    /// Radiance from infinity by direction, from an environment image, importance-sampled
+    /// (physically based integrators only). `radiance` is the map's average, for Whitted's
+    /// model and the light's power.
+    Environment {
+        map: EnvironmentLight,
+        radiance: Color,
+    },
+}
+
+/// An environment map shared by the scene's copies of its light, with where it came from
+/// (to write the scene back); equal when it is the same map.
+#[derive(Clone, Debug)]
+pub struct EnvironmentLight {
+    pub map: Arc<EnvironmentMap>,
+    /// The image file, as the scene named it, resolved.
+    pub file: String,
+    /// The factor the image's radiance was scaled by.
+    pub scale: f64,
+}
+
+impl PartialEq for EnvironmentLight {
+    fn eq(&self, o: &Self) -> bool {
+        Arc::ptr_eq(&self.map, &o.map)
+    }
 }
 
 /// The surface of an area light, in world coordinates.
@@ -303,6 +329,9 @@ pub struct LightSample {
     pub pdf: f64,
     /// The light is a point or a direction: no other strategy can find it.
     pub delta: bool,
+    /// Radiance that depends on the direction (an environment map's, linear RGB), in place
+    /// of the light's spectrum times `scale`.
+    pub radiance: Option<Color>,
     /// Where the shadow ray stops, as a fraction of the way to `position`.
     pub shadow_end: f64,
 }
@@ -372,6 +401,7 @@ impl Light {
                     scale: if lit { 1.0 } else { 0.0 },
                     pdf,
                     delta: false,
+                    radiance: None,
                     shadow_end: AREA_SHADOW_END,
                 })
             }
@@ -384,6 +414,20 @@ impl Light {
                     scale: 1.0,
                     pdf: 1.0 / (4.0 * std::f64::consts::PI),
                     delta: false,
+                    radiance: None,
+                    shadow_end: f64::INFINITY,
+                })
+            }
+            Light::Environment { ref map, .. } => {
+                let (wi, pdf, [r, g, b]) = map.map.sample(u)?;
+                Some(LightSample {
+                    wi,
+                    distance: f64::INFINITY,
+                    position: None,
+                    scale: 1.0,
+                    pdf,
+                    delta: false,
+                    radiance: Some(Color::new(r, g, b)),
                     shadow_end: f64::INFINITY,
                 })
             }
@@ -406,6 +450,7 @@ impl Light {
                     scale: falloff / d2,
                     pdf: 1.0,
                     delta: true,
+                    radiance: None,
                     shadow_end: inc.shadow_end,
                 })
             }
@@ -416,19 +461,34 @@ impl Light {
                 scale: 1.0,
                 pdf: 1.0,
                 delta: true,
+                radiance: None,
                 shadow_end: f64::INFINITY,
             }),
         }
     }
 
     /// The solid-angle pdf at `p` of [`Light::sample_li`] choosing the point `q` (unit normal
-    /// `n`) of an area light, or the direction `wi` of an infinite light; 0 for delta lights.
+    /// `n`) of an area light; 0 for other lights.
     pub fn pdf_li(&self, p: Vec3, q: Vec3, n: Vec3) -> f64 {
         match self {
             Light::Area { shape, .. } => shape.pdf(p, q, n),
-            Light::Infinite { .. } => 1.0 / (4.0 * std::f64::consts::PI),
             _ => 0.0,
         }
+    }
+
+    /// The solid-angle pdf of [`Light::sample_li`] choosing the direction `wi` of a light at
+    /// infinity; 0 for other lights.
+    pub fn pdf_direction(&self, wi: Vec3) -> f64 {
+        match self {
+            Light::Infinite { .. } => 1.0 / (4.0 * std::f64::consts::PI),
+            Light::Environment { map, .. } => map.map.pdf(wi),
+            _ => 0.0,
+        }
+    }
+
+    /// A light at infinity, which rays that leave the scene see.
+    pub fn is_infinite(&self) -> bool {
+        matches!(self, Light::Infinite { .. } | Light::Environment { .. })
     }
 
     /// Whether an area light's surface, with unit normal `n`, emits toward `w`.
@@ -462,6 +522,7 @@ impl Light {
             }
             Light::Directional { intensity, .. } => PI * radius * radius * intensity.luminance(),
             Light::Infinite { radiance } => 4.0 * PI * PI * radius * radius * radiance.luminance(),
+            Light::Environment { map, .. } => map.map.power_estimate(radius),
         }
     }
 
@@ -471,7 +532,9 @@ impl Light {
             Light::Point { intensity, .. }
             | Light::Spot { intensity, .. }
             | Light::Directional { intensity, .. } => *intensity = c,
-            Light::Area { radiance, .. } | Light::Infinite { radiance } => *radiance = c,
+            Light::Area { radiance, .. }
+            | Light::Infinite { radiance }
+            | Light::Environment { radiance, .. } => *radiance = c,
         }
     }
 
@@ -481,7 +544,9 @@ impl Light {
             Light::Point { intensity, .. }
             | Light::Spot { intensity, .. }
             | Light::Directional { intensity, .. } => intensity,
-            Light::Area { radiance, .. } | Light::Infinite { radiance } => radiance,
+            Light::Area { radiance, .. }
+            | Light::Infinite { radiance }
+            | Light::Environment { radiance, .. } => radiance,
         }
     }
 
@@ -489,8 +554,8 @@ impl Light {
     /// that are points), before any shadowing; `None` when nothing arrives.
     pub fn incident(&self, p: Vec3, u: [f64; 2]) -> Option<Incident> {
         match *self {
-            // Not a light of Whitted's model: the path tracer's only.
-            Light::Infinite { .. } => None,
+            // Not lights of Whitted's model: the path tracer's only.
+            Light::Infinite { .. } | Light::Environment { .. } => None,
             Light::Area {
                 ref shape,
                 radiance,

@@ -356,6 +356,33 @@ impl Scene {
         self.light_spectra[light as usize].sample(wl)
     }
 
+    /// Radiance given as linear RGB (an environment map's), as an illuminant spectrum at
+    /// the sample's wavelengths.
+    #[inline]
+    pub fn rgb_radiance(&self, c: Color, wl: &SampledWavelengths) -> SampledSpectrum {
+        if wl.is_rgb() {
+            SampledSpectrum([c.r, c.g, c.b, 0.0])
+        } else {
+            crate::material::uplift_illuminant(c, wl)
+        }
+    }
+
+    /// What light `light`, one at infinity, sends along -`d` toward the scene.
+    pub fn radiance_from_infinity(
+        &self,
+        light: u32,
+        d: Vec3,
+        wl: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        match &self.lights[light as usize] {
+            Light::Environment { map, .. } => {
+                let [r, g, b] = map.map.radiance(d);
+                self.rgb_radiance(Color::new(r, g, b), wl)
+            }
+            _ => self.light_spectrum(light, wl),
+        }
+    }
+
     /// The background's radiance at the sample's wavelengths.
     #[inline]
     pub fn background_spectrum(&self, wl: &SampledWavelengths) -> SampledSpectrum {
@@ -768,7 +795,7 @@ impl SceneBuilder {
             }
         }
         let infinite_lights = (0..self.lights.len() as u32)
-            .filter(|&i| matches!(self.lights[i as usize], Light::Infinite { .. }))
+            .filter(|&i| self.lights[i as usize].is_infinite())
             .collect();
         let mut scene = Scene {
             background_spectrum: SpectrumValue::from_rgb(self.background, SpectrumKind::Illuminant),

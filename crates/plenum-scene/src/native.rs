@@ -665,14 +665,29 @@ impl<'s> Reader<'s> {
                 self.light_spectrum(&f)?;
             }
             "infinite" => {
-                let f = self
-                    .src
-                    .table(v, &what, &["type", "name", "color", "intensity", "spectrum"])?;
-                let light = Light::Infinite {
-                    radiance: intensity(&f)?,
-                };
-                self.builder.add_light(name_of(&f)?, light);
-                self.light_spectrum(&f)?;
+                let f = self.src.table(
+                    v,
+                    &what,
+                    &["type", "name", "color", "intensity", "spectrum", "file", "layout", "up"],
+                )?;
+                if let Some(file) = f.get("file") {
+                    for key in ["color", "spectrum"] {
+                        if let Some(c) = f.get(key) {
+                            return Err(self.src.error(
+                                c.span(),
+                                format!("an environment map gives the light's radiance: drop `{key}`"),
+                            ));
+                        }
+                    }
+                    let light = self.environment(&f, file)?;
+                    self.builder.add_light(name_of(&f)?, light);
+                } else {
+                    let light = Light::Infinite {
+                        radiance: intensity(&f)?,
+                    };
+                    self.builder.add_light(name_of(&f)?, light);
+                    self.light_spectrum(&f)?;
+                }
             }
             _ => {
                 let f = self
@@ -691,6 +706,43 @@ impl<'s> Reader<'s> {
             DeValue::String(_) | DeValue::Table(_) => Ok((Color::BLACK, Some(self.spectrum(v)?))),
             _ => Ok((self.non_negative(v, self.color(v)?)? * scale, None)),
         }
+    }
+
+    /// An infinite light from an environment image (`file`: EXR, HDR, PFM, PNG or JPEG), in
+    /// the latitude–longitude layout or pbrt-v4's equal-area square (`layout`), its pole
+    /// along `up` (default +y), its radiance times `intensity`.
+    fn environment(&self, f: &Fields<'_, 's>, file: &Value<'s>) -> Result<Light> {
+        use plenum_core::environment::{EnvironmentLayout, EnvironmentMap};
+        let path = self.base_dir.join(self.src.string(file)?);
+        let image = plenum_image::read_float_image(&path)
+            .map_err(|e| self.src.error(file.span(), e.to_string()))?;
+        let layout = match f.get("layout") {
+            None => EnvironmentLayout::LatLong,
+            Some(l) => match self.src.string(l)? {
+                "latlong" => EnvironmentLayout::LatLong,
+                "equalarea" => EnvironmentLayout::EqualArea,
+                other => {
+                    return Err(self
+                        .src
+                        .error(l.span(), format!("unknown layout `{other}`"))
+                        .with_help("expected `latlong` or `equalarea`"))
+                }
+            },
+        };
+        let up = f.direction("up", Some(Vec3::Y))?.normalized();
+        let scale = f.non_negative_or("intensity", 1.0)?;
+        let frame = plenum_core::sampling::Frame::from_z(up);
+        let map = EnvironmentMap::new(image.width as usize, image.height as usize, image.pixels, layout, frame, scale)
+            .map_err(|e| self.src.error(file.span(), e))?;
+        let [r, g, b] = map.average();
+        Ok(Light::Environment {
+            map: plenum_core::light::EnvironmentLight {
+                map: std::sync::Arc::new(map),
+                file: path.display().to_string(),
+                scale,
+            },
+            radiance: Color::new(r, g, b),
+        })
     }
 
     /// A light's `spectrum`, which replaces its `color` (times its `intensity`).

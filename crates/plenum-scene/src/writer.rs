@@ -173,6 +173,19 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                 };
                 let _ = writeln!(w, "color = {}\nsamples = {samples}\n", color(*radiance));
             }
+            Light::Environment { map, .. } => {
+                let layout = match map.map.layout() {
+                    plenum_core::environment::EnvironmentLayout::LatLong => "latlong",
+                    plenum_core::environment::EnvironmentLayout::EqualArea => "equalarea",
+                };
+                let _ = writeln!(
+                    w,
+                    "type = \"infinite\"\nfile = {}\nlayout = \"{layout}\"\nup = {}\nintensity = {:?}\n",
+                    quote(&map.file),
+                    vec(map.map.frame().z),
+                    map.scale
+                );
+            }
             Light::Infinite { radiance } => {
                 let _ = writeln!(w, "type = \"infinite\"\ncolor = {}\n", color(*radiance));
             }

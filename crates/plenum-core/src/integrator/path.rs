@@ -243,11 +243,11 @@ impl<'a> PathTracer<'a> {
         let mut le = scene.background_spectrum(wl);
         for &i in &scene.infinite_lights {
             let light = &scene.lights[i as usize];
-            let radiance = scene.light_spectrum(i, wl);
+            let radiance = scene.radiance_from_infinity(i, d, wl);
             if specular_bounce {
                 le += radiance;
             } else {
-                let pdf_light = scene.light_sampler.pmf(i) * light.pdf_li(Vec3::ZERO, d, d);
+                let pdf_light = scene.light_sampler.pmf(i) * light.pdf_direction(d);
                 le += radiance * power_heuristic(pdf_bsdf, pdf_light);
             }
         }
@@ -288,7 +288,10 @@ impl<'a> PathTracer<'a> {
         if self.occluded(it, &ls, ray.time) {
             return SampledSpectrum::ZERO;
         }
-        let le = scene.light_spectrum(index, wl) * ls.scale;
+        let le = match ls.radiance {
+            Some(c) => scene.rgb_radiance(c, wl),
+            None => scene.light_spectrum(index, wl) * ls.scale,
+        };
         let pdf_light = pmf * ls.pdf;
         if ls.delta {
             return f * le / pdf_light;

@@ -10,7 +10,7 @@ mod param;
 mod phong;
 mod physical;
 
-pub use param::{scaled, source_rgb, uplift, FloatTexture, SpectralTexture, SpectrumKind, SpectrumValue};
+pub use param::{scaled, source_rgb, uplift, uplift_illuminant, FloatTexture, SpectralTexture, SpectrumKind, SpectrumValue};
 pub use phong::{Coefficients, PhongMaterial};
 pub use physical::{
     CoatedDiffuseMaterial, ConductorMaterial, ConductorSpec, DielectricMaterial,

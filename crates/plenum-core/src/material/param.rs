@@ -166,6 +166,11 @@ pub(crate) fn uplift_at(c: Color, kind: SpectrumKind, wl: &SampledWavelengths) -
     s
 }
 
+/// Emitted radiance given as linear RGB, at the sample's wavelengths.
+pub fn uplift_illuminant(c: Color, wl: &SampledWavelengths) -> SampledSpectrum {
+    uplift_at(c, SpectrumKind::Illuminant, wl)
+}
+
 /// `s` times `k`, as a spectrum of the same kind.
 pub fn scaled(s: &Spectrum, k: f64) -> Spectrum {
     if k == 1.0 {
