@@ -71,8 +71,10 @@ open(OUT + "illuminants.rs", "w").write(src.rstrip() + "\n")
 # --- metals ---
 src = ("//! Measured complex refractive indices n + ik of metals, (wavelength nm, value) pairs.\n//!\n"
        "//! - Ag, Al, Au, Cu: as tabulated in pbrt-v4 (src/pbrt/util/spectrum.cpp, `Ag_eta` … `Cu_k`),\n"
-       "//!   which resampled measurements from Palik, \"Handbook of Optical Constants of Solids\"\n"
-       "//!   (1985); all share one wavelength grid.\n"
+       "//!   all on one wavelength grid; pbrt-v4 does not name the measurement (its Ag η is\n"
+       "//!   identical to Mitsuba 0.6's data/ior/Ag.eta.spd, credited to the luxpop database).\n"
+       "//! - CuZn (brass): pbrt-v4's `CuZn_eta`, `CuZn_k` (290–890 nm, 10 nm), from a later\n"
+       "//!   revision of the same file; pbrt-v4 does not name the measurement.\n"
        "//! - Cr: Mitsuba 0.6 data/ior/Cr.eta.spd, Cr.k.spd (luxpop database: LLNL/CXRO + Palik).\n"
        "//! - Ti: the Lorentz–Drude model of Rakić, Djurišić, Elazar and Majewski 1998, \"Optical\n"
        "//!   properties of metallic films for vertical-cavity optoelectronic devices\", Appl. Opt. 37,\n"
@@ -86,8 +88,10 @@ def pairs(name, lam, vals, doc):
     return s + "];\n\n"
 names = {"Ag": "silver", "Al": "aluminium", "Au": "gold", "Cu": "copper"}
 for el, full in names.items():
-    src += pairs(f"{el.upper()}_ETA", m.LAMBDA, getattr(m, el + "_eta"), f"Real index η of {full} (Palik, via pbrt-v4).")
-    src += pairs(f"{el.upper()}_K", m.LAMBDA, getattr(m, el + "_k"), f"Extinction coefficient k of {full} (Palik, via pbrt-v4).")
+    src += pairs(f"{el.upper()}_ETA", m.LAMBDA, getattr(m, el + "_eta"), f"Real index η of {full} (via pbrt-v4).")
+    src += pairs(f"{el.upper()}_K", m.LAMBDA, getattr(m, el + "_k"), f"Extinction coefficient k of {full} (via pbrt-v4).")
+src += pairs("CUZN_ETA", m.CuZn_lambda, m.CuZn_eta, "Real index η of brass (CuZn), via pbrt-v4.")
+src += pairs("CUZN_K", m.CuZn_lambda, m.CuZn_k, "Extinction coefficient k of brass (CuZn), via pbrt-v4.")
 src += pairs("CR_ETA", m.Cr_lambda, m.Cr_eta, "Real index η of chromium (luxpop, via Mitsuba 0.6).")
 src += pairs("CR_K", m.Cr_lambda, m.Cr_k, "Extinction coefficient k of chromium (luxpop, via Mitsuba 0.6).")
 # Rakić 1998 Ti Lorentz-Drude
