@@ -131,6 +131,8 @@ fn all() -> &'static [(&'static str, Spectrum)] {
             ("metal-Au-k", table(&metals::AU_K)),
             ("metal-Cu-eta", table(&metals::CU_ETA)),
             ("metal-Cu-k", table(&metals::CU_K)),
+            ("metal-CuZn-eta", table(&metals::CUZN_ETA)),
+            ("metal-CuZn-k", table(&metals::CUZN_K)),
             ("metal-Cr-eta", table(&metals::CR_ETA)),
             ("metal-Cr-k", table(&metals::CR_K)),
             ("metal-Ti-eta", table(&metals::TI_ETA)),
@@ -253,7 +255,7 @@ mod tests {
 
     #[test]
     fn metals_positive_over_the_visible() {
-        for m in ["Ag", "Al", "Au", "Cu", "Cr", "Ti"] {
+        for m in ["Ag", "Al", "Au", "Cu", "CuZn", "Cr", "Ti"] {
             for l in (360..=830).step_by(2) {
                 let l = l as f64;
                 let eta = named(&format!("metal-{m}-eta")).unwrap().eval(l);
@@ -267,13 +269,14 @@ mod tests {
     fn metal_normal_reflectance_matches_published() {
         // Normal-incidence reflectance at 450 / 550 / 650 nm. Al: 91.5 % at 550 nm for bare
         // aluminium (RMI mirror specification). The others are the handbook values of the
-        // same Palik / luxpop / Rakić constants rounded (not an independent measurement; see
+        // same tabulated / Rakić constants rounded (not an independent measurement; see
         // docs/spectra.md): they guard the transcription and the interpolation.
         let published = [
             ("Ag", [0.92, 0.96, 0.97]),
             ("Al", [0.92, 0.915, 0.91]),
             ("Au", [0.38, 0.84, 0.94]),
             ("Cu", [0.56, 0.62, 0.94]),
+            ("CuZn", [0.43, 0.79, 0.89]),
             ("Cr", [0.70, 0.66, 0.64]),
             ("Ti", [0.58, 0.57, 0.58]),
         ];
@@ -289,6 +292,7 @@ mod tests {
         }
         assert!(reflectance("Au", 650.0) > reflectance("Au", 450.0));
         assert!(reflectance("Ag", 550.0) > 0.95);
+        assert!(reflectance("CuZn", 650.0) > reflectance("CuZn", 450.0));
     }
 
     #[test]

@@ -11,8 +11,9 @@ use std::ops::{Add, AddAssign, Div, DivAssign, Index, IndexMut, Mul, MulAssign, 
 /// Wavelengths a sample carries.
 pub const N_SAMPLES: usize = 4;
 
-/// The visible range sampled, in nm.
+/// The shortest wavelength sampled, nm.
 pub const LAMBDA_MIN: f64 = 360.0;
+/// The longest wavelength sampled, nm.
 pub const LAMBDA_MAX: f64 = 830.0;
 
 /// Spectral values (radiance, reflectance, a path's throughput) at the sample's wavelengths,
@@ -21,17 +22,22 @@ pub const LAMBDA_MAX: f64 = 830.0;
 pub struct SampledSpectrum(pub [f64; N_SAMPLES]);
 
 impl SampledSpectrum {
+    /// 0 in every lane.
     pub const ZERO: SampledSpectrum = SampledSpectrum([0.0; N_SAMPLES]);
+    /// 1 in every lane.
     pub const ONE: SampledSpectrum = SampledSpectrum([1.0; N_SAMPLES]);
 
+    /// `v` in every lane.
     pub const fn splat(v: f64) -> Self {
         SampledSpectrum([v; N_SAMPLES])
     }
 
+    /// `f` applied to each lane.
     pub fn map(self, f: impl Fn(f64) -> f64) -> Self {
         SampledSpectrum(self.0.map(f))
     }
 
+    /// `f` applied lane by lane to `self` and `o`.
     pub fn zip(self, o: Self, f: impl Fn(f64, f64) -> f64) -> Self {
         let mut r = self;
         for i in 0..N_SAMPLES {
@@ -40,18 +46,22 @@ impl SampledSpectrum {
         r
     }
 
+    /// Every lane is 0.
     pub fn is_black(&self) -> bool {
         self.0.iter().all(|&v| v == 0.0)
     }
 
+    /// The largest lane.
     pub fn max_value(&self) -> f64 {
         self.0.iter().copied().fold(f64::NEG_INFINITY, f64::max)
     }
 
+    /// The smallest lane.
     pub fn min_value(&self) -> f64 {
         self.0.iter().copied().fold(f64::INFINITY, f64::min)
     }
 
+    /// The mean of the lanes (in RGB mode the unused lane counts as 0).
     pub fn average(&self) -> f64 {
         self.0.iter().sum::<f64>() / N_SAMPLES as f64
     }
@@ -66,14 +76,17 @@ impl SampledSpectrum {
         self.zip(o, |a, b| if b != 0.0 { a / b } else { 0.0 })
     }
 
+    /// Square root per lane, negatives taken as 0.
     pub fn sqrt(self) -> Self {
         self.map(|v| v.max(0.0).sqrt())
     }
 
+    /// e^x per lane (transmittance from optical depth).
     pub fn exp(self) -> Self {
         self.map(f64::exp)
     }
 
+    /// Negative lanes set to 0.
     pub fn clamp_zero(self) -> Self {
         self.map(|v| v.max(0.0))
     }
@@ -222,18 +235,22 @@ impl SampledWavelengths {
         Self::from_parts(lambda, pdf)
     }
 
+    /// Spectral or RGB.
     pub fn mode(&self) -> ColorMode {
         self.mode
     }
 
+    /// Whether the lanes are RGB channels.
     pub fn is_rgb(&self) -> bool {
         self.mode == ColorMode::Rgb
     }
 
+    /// The wavelengths, nm (589.3 in every lane in RGB mode).
     pub fn lambda(&self) -> &[f64; N_SAMPLES] {
         &self.lambda
     }
 
+    /// The sampling densities, per nm (RGB mode: 1, 1, 1, 0).
     pub fn pdf(&self) -> SampledSpectrum {
         SampledSpectrum(self.pdf)
     }
@@ -252,6 +269,7 @@ impl SampledWavelengths {
         self.pdf[0] /= N_SAMPLES as f64;
     }
 
+    /// Whether only the hero wavelength still carries the path.
     pub fn secondary_terminated(&self) -> bool {
         !self.is_rgb() && self.pdf[1..].iter().all(|&p| p == 0.0)
     }

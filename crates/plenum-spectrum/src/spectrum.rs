@@ -111,30 +111,61 @@ pub enum Spectrum {
     PiecewiseLinear(Arc<PiecewiseLinear>),
     /// `scale` × the blackbody spectrum at `kelvin` K normalised to 1 at its peak (pbrt-v4's
     /// `BlackbodySpectrum`); an emission spectrum.
-    Blackbody { kelvin: f64, scale: f64 },
+    Blackbody {
+        /// Temperature, K.
+        kelvin: f64,
+        /// Value at the peak wavelength.
+        scale: f64,
+    },
     /// A reflectance in [0, 1] from linear-sRGB `rgb` (clamped to [0, 1]): the sigmoid.
-    RgbAlbedo { rgb: [f64; 3], sigmoid: RgbSigmoid },
+    RgbAlbedo {
+        /// The linear-sRGB reflectance given, in [0, 1].
+        rgb: [f64; 3],
+        /// Its uplifted spectrum.
+        sigmoid: RgbSigmoid,
+    },
     /// An unbounded positive quantity from `rgb`: `scale` · sigmoid(λ) with scale = 2 · max
     /// component and the sigmoid fitted to rgb / scale (pbrt-v4's `RGBUnboundedSpectrum`).
     RgbUnbounded {
+        /// The linear-sRGB value given, ≥ 0.
         rgb: [f64; 3],
+        /// 2 × the largest component.
         scale: f64,
+        /// The sigmoid of rgb / scale.
         sigmoid: RgbSigmoid,
     },
     /// Emission from `rgb`: the unbounded form times D65 of unit luminance
     /// ([`d65_normalized`]), so seen directly it converts back to `rgb` (pbrt-v4's
     /// `RGBIlluminantSpectrum`).
     RgbIlluminant {
+        /// The linear-sRGB radiance given, ≥ 0.
         rgb: [f64; 3],
+        /// 2 × the largest component.
         scale: f64,
+        /// The sigmoid of rgb / scale.
         sigmoid: RgbSigmoid,
     },
     /// Sellmeier's dispersion formula n(λ) = √(1 + Σ Bᵢ λ² / (λ² − Cᵢ)), λ in µm, C in µm².
-    Sellmeier { b: [f64; 3], c: [f64; 3] },
+    Sellmeier {
+        /// Oscillator strengths Bᵢ, dimensionless.
+        b: [f64; 3],
+        /// Resonance wavelengths squared Cᵢ, µm².
+        c: [f64; 3],
+    },
     /// The four-term Sellmeier formula (Daimon and Masumura's form for water), λ in µm.
-    Sellmeier4 { b: [f64; 4], c: [f64; 4] },
+    Sellmeier4 {
+        /// Oscillator strengths Bᵢ, dimensionless.
+        b: [f64; 4],
+        /// Resonance wavelengths squared Cᵢ, µm².
+        c: [f64; 4],
+    },
     /// Cauchy's formula n(λ) = a + b / λ², λ in µm, b in µm².
-    Cauchy { a: f64, b: f64 },
+    Cauchy {
+        /// The index at infinite wavelength.
+        a: f64,
+        /// The dispersion coefficient, µm².
+        b: f64,
+    },
     /// The refractive index of standard dry air (15 °C, 101 325 Pa, 450 ppm CO₂) after
     /// Ciddor 1996, "Refractive index of air: new equations for the visible and near
     /// infrared", Appl. Opt. 35, 1566: n − 1 = 0.05792105 / (238.0185 − σ²) +
@@ -448,7 +479,7 @@ mod tests {
     fn d65_illuminant_white_is_srgb_white() {
         let d65 = Spectrum::rgb_illuminant([1.0; 3]);
         // Spectral: the integral the film estimates.
-        let rgb = reflectance_free_integral(&d65);
+        let rgb = emitted_rgb(&d65);
         assert!(close3(rgb, [1.0; 3], 0.01), "{rgb:?}");
         // And by Monte Carlo through to_linear_srgb, many stratified samples.
         let n = 2000;
@@ -463,7 +494,7 @@ mod tests {
         assert!(close3(acc, [1.0; 3], 0.01), "{acc:?}");
     }
 
-    fn reflectance_free_integral(s: &Spectrum) -> [f64; 3] {
+    fn emitted_rgb(s: &Spectrum) -> [f64; 3] {
         illuminant_to_rgb(|l| s.eval(l))
     }
 
@@ -477,7 +508,7 @@ mod tests {
             [0.05, 0.3, 0.01],
         ] {
             let s = Spectrum::rgb_illuminant(rgb);
-            let back = reflectance_free_integral(&s);
+            let back = emitted_rgb(&s);
             let m = rgb.iter().copied().fold(0.0, f64::max);
             for i in 0..3 {
                 assert!((back[i] - rgb[i]).abs() < 0.01 * m, "{rgb:?} → {back:?}");

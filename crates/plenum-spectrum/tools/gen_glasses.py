@@ -38,4 +38,4 @@ for name, t in [("SF5", SF5), ("SF10", SF10), ("SF11", SF11)]:
     for i in range(0, n, 4):
         src += "    " + " ".join(f"({float(t[2*j])!r}, {t[2*j+1]!r})," for j in range(i, min(n, i + 4))) + "\n"
     src += "];\n\n"
-open(OUT, "w").write(src)
+open(OUT, "w").write(src.rstrip() + "\n")
