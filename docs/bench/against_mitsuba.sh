@@ -150,8 +150,8 @@ if speed:
     print(f"\nSpeed: Cornell box 256x256, {spp} spp, {speed[0]['summary']['threads']} threads; "
           f"medians of {nrounds} rounds; seconds, wall (CPU)")
     print(f"{'mode':9} {'Plenum':>15} {'Mitsuba whole':>15} {'in it: 1st render':>17} "
-          f"{'Mitsuba steady':>15} {'M/P whole':>10} {'M steady/P':>10}  Plenum mean/ref  Mitsuba mean/ref")
-    pw = {}
+          f"{'Mitsuba steady':>15} {'M/P whole':>10} {'M steady/P':>10} {'(CPU)':>6}  Plenum mean/ref  Mitsuba mean/ref")
+    pw, pc, mc_ = {}, {}, {}
     for mode in modes:
         p, m, st = pick("speed", "plenum", mode), pick("speed", "mitsuba", mode), pick("steady", "mitsuba", mode)
         pwall, pcpu = med([r["wall_s"] for r in p]), med([r["cpu_s"] for r in p])
@@ -159,16 +159,17 @@ if speed:
         first = med([r["summary"]["first_s"] for r in m])
         swall = med([r["summary"]["steady_median_s"] for r in st])
         scpu = med([r["summary"]["steady_cpu_median_s"] for r in st])
-        pw[mode] = pwall
+        pw[mode], pc[mode], mc_[mode] = pwall, pcpu, scpu
         f = lambda w, c: f"{w:7.3f} ({c:5.2f})" if w == w else f"{'-':>15}"
         meanrel = lambda rs: " ".join(f"{med([r['q']['mean_rel_diff_rgb'][i] for r in rs]):+.2%}" for i in range(3)) if rs else "-"
         print(f"{mode:9} {f(pwall, pcpu)} {f(mwall, mcpu)} {first:17.3f} {f(swall, scpu)} "
-              f"{mwall / pwall:10.3f} {swall / pwall:10.3f}  {meanrel(p):>15}  {meanrel(m)}")
+              f"{mwall / pwall:10.3f} {swall / pwall:10.3f} {scpu / pcpu:6.3f}  {meanrel(p):>15}  {meanrel(m)}")
+    print("(M/P: Mitsuba's time / Plenum's whole process, wall; (CPU): Mitsuba's steady render / Plenum's whole process, CPU time)")
     if "rgb" in pw and "spectral" in pw and pw["rgb"] == pw["rgb"]:
-        print(f"Plenum spectral / rgb: {pw['spectral'] / pw['rgb']:.3f}")
+        print(f"Plenum spectral / rgb: {pw['spectral'] / pw['rgb']:.3f} wall, {pc['spectral'] / pc['rgb']:.3f} CPU")
     ms = {mode: med([r["summary"]["steady_median_s"] for r in pick("steady", "mitsuba", mode)]) for mode in modes}
     if "rgb" in ms and "spectral" in ms:
-        print(f"Mitsuba spectral / rgb (steady): {ms['spectral'] / ms['rgb']:.3f}")
+        print(f"Mitsuba spectral / rgb (steady): {ms['spectral'] / ms['rgb']:.3f} wall, {mc_['spectral'] / mc_['rgb']:.3f} CPU")
     for mode in modes:
         for who in ("plenum", "mitsuba"):
             e = [r["q"]["rmse_less_ref_noise"] for r in pick("speed", who, mode)]
