@@ -117,6 +117,7 @@ fi
 "$py" - "$out" "$refs" "$here" <<'PY'
 import json, math, statistics, sys
 out, refs, here = sys.argv[1:4]
+sys.dont_write_bytecode = True  # no __pycache__ in docs/bench
 sys.path.insert(0, here)
 import os
 import mitsuba_compare as mc
@@ -147,7 +148,7 @@ speed = [r for r in runs if r["part"] == "speed"]
 if speed:
     spp = speed[0]["spp"]
     nrounds = max(r["round"] for r in speed)
-    print(f"\nSpeed: Cornell box 256x256, {spp} spp, {speed[0]['summary']['threads']} threads; "
+    print(f"\nSpeed: Cornell box 256x256, {spp} spp, {[r for r in runs if 'summary' in r][0]['summary']['threads']} threads; "
           f"medians of {nrounds} rounds; seconds, wall (CPU)")
     print(f"{'mode':9} {'Plenum':>15} {'Mitsuba whole':>15} {'in it: 1st render':>17} "
           f"{'Mitsuba steady':>15} {'M/P whole':>10} {'M steady/P':>10} {'(CPU)':>6}  Plenum mean/ref  Mitsuba mean/ref")
