@@ -170,6 +170,8 @@ pub fn render(
             film.set(x, y, colors[(y * w + x) as usize]);
         }
     }
+    // No integrator here splats yet (light tracing will); resolving keeps the one path.
+    film.resolve(1.0);
     RenderOutput {
         film: if settings.corners {
             average_corners(&film)
