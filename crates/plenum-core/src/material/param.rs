@@ -7,6 +7,7 @@
 //! bounded by 1, indices of refraction are not, emitters are illuminants.
 
 use crate::color::Color;
+use std::sync::OnceLock;
 use crate::texture::{Texture, TextureCoords};
 use plenum_spectrum::uplift::d65_normalized;
 use plenum_spectrum::{RgbToSpectrumTable, SampledSpectrum, SampledWavelengths, Spectrum};
@@ -32,11 +33,13 @@ pub fn uplift(c: Color, kind: SpectrumKind) -> Spectrum {
     }
 }
 
-/// A spectrum with its RGB projection kept for RGB mode.
+/// A spectrum with its RGB projection kept for RGB mode. One given as RGB is uplifted only
+/// when a spectral render first asks for it, so RGB renders never build the uplift table.
 #[derive(Clone, Debug)]
 pub struct SpectrumValue {
-    spectrum: Spectrum,
+    spectrum: OnceLock<Spectrum>,
     rgb: [f64; 3],
+    kind: SpectrumKind,
 }
 
 impl SpectrumValue {
@@ -45,13 +48,18 @@ impl SpectrumValue {
             SpectrumKind::Illuminant => spectrum.to_rgb_illuminant(),
             _ => spectrum.to_rgb_reflectance(),
         };
-        SpectrumValue { spectrum, rgb }
+        SpectrumValue {
+            spectrum: OnceLock::from(spectrum),
+            rgb,
+            kind,
+        }
     }
 
     pub fn from_rgb(c: Color, kind: SpectrumKind) -> SpectrumValue {
         SpectrumValue {
-            spectrum: uplift(c, kind),
+            spectrum: OnceLock::new(),
             rgb: [c.r, c.g, c.b],
+            kind,
         }
     }
 
@@ -61,7 +69,7 @@ impl SpectrumValue {
             let [r, g, b] = self.rgb;
             SampledSpectrum([r, g, b, 0.0])
         } else {
-            self.spectrum.sample(wl)
+            self.spectrum().sample(wl)
         }
     }
 
@@ -70,7 +78,10 @@ impl SpectrumValue {
     }
 
     pub fn spectrum(&self) -> &Spectrum {
-        &self.spectrum
+        self.spectrum.get_or_init(|| {
+            let [r, g, b] = self.rgb;
+            uplift(Color::new(r, g, b), self.kind)
+        })
     }
 }
 
