@@ -77,6 +77,26 @@ fn example_scenes_render() {
     assert!(count >= 1);
 }
 
+/// A dispersive scene rendered in RGB says that it needs wavelengths.
+#[test]
+fn rgb_mode_warns_about_dispersion() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/prism.toml");
+    let tmp = temp_dir("prism");
+    let o = plenum()
+        .arg("render")
+        .arg(&scene)
+        .args(["--width", "16", "--height", "12", "--spp", "1", "--color", "rgb", "-o"])
+        .arg(tmp.path().join("x.png"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("material `flint` (a dispersive η) needs wavelengths"),
+        "{}",
+        stderr(&o)
+    );
+}
+
 #[test]
 fn trace_pixel_shows_the_ray_tree() {
     // The centre of the glass sphere in the built-in scene at 64×48.

@@ -398,3 +398,46 @@ material = "half"
         }
     }
 }
+
+/// An RGB emitter seen directly renders as its own RGB value in both colour modes (the
+/// illuminant uplift times D65 of unit luminance, integrated against the CIE observer,
+/// within 1 % spectrally; exactly in RGB), and a scene of physically based materials only
+/// is path traced unless told otherwise.
+#[test]
+fn an_rgb_emitter_seen_directly_shows_its_rgb() {
+    let l = scene(
+        r#"
+[camera]
+position = [0, 0, 3]
+look_at = [0, 0, 0]
+fov = 20
+resolution = [8, 8]
+
+[materials.black]
+type = "diffuse"
+reflectance = 0
+
+[[objects]]
+type = "mesh"
+material = "black"
+positions = [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]
+indices = [[0, 1, 2], [0, 2, 3]]
+emission = [17, 12, 4]
+two_sided = false
+"#,
+    );
+    assert_eq!(l.scene.default_integrator(), IntegratorKind::Path);
+    for (color, tolerance) in [(ColorMode::Rgb, 1e-6), (ColorMode::Spectral, 0.01)] {
+        let m = mean(&draw(&l, &path_settings(&l, 64, color, 2)));
+        for (got, want) in m.iter().zip([17.0, 12.0, 4.0]) {
+            assert!(
+                (got / want - 1.0).abs() <= tolerance,
+                "{color:?}: {m:?}, expected (17, 12, 4)"
+            );
+        }
+    }
+    assert_eq!(
+        plenum_scene::builtin_scene().scene.default_integrator(),
+        IntegratorKind::Whitted
+    );
+}

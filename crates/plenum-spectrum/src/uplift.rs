@@ -323,7 +323,7 @@ pub struct RgbToSpectrumTable {
 const TABLE_TOLERANCE: f64 = 1e-4;
 
 /// The resolution of [`RgbToSpectrumTable::srgb`]: build time and accuracy measured in the
-/// ignored test `uplift::tests::table_resolution_survey` (see docs/spectra.md).
+/// benchmark `benches/uplift_table.rs` (see docs/spectra.md).
 pub const SRGB_TABLE_RES: usize = 24;
 
 impl RgbToSpectrumTable {
@@ -542,38 +542,5 @@ mod tests {
             worst = worst.max(max_err(rgb, back));
         }
         assert!(worst < 0.01, "worst {worst}");
-    }
-
-    /// Build time and accuracy per resolution, on one core:
-    /// `cargo test -j 1 -p plenum-spectrum --release -- --ignored --nocapture table_resolution_survey`
-    #[test]
-    #[ignore]
-    fn table_resolution_survey() {
-        let mut rng = Pcg(7);
-        let colours: Vec<[f64; 3]> = (0..2000)
-            .map(|_| [rng.next_f64(), rng.next_f64(), rng.next_f64()])
-            .collect();
-        let mut fit_worst = 0.0f64;
-        for &rgb in &colours {
-            let s = RgbSigmoid::fit(rgb);
-            fit_worst = fit_worst.max(max_err(rgb, reflectance_to_rgb(|l| s.eval(l))));
-        }
-        println!("exact fit: max err {fit_worst:.5}");
-        for res in [8, 12, 16, 24, 32, 48, 64] {
-            let t0 = std::time::Instant::now();
-            let table = RgbToSpectrumTable::build(res);
-            let dt = t0.elapsed();
-            let (mut worst, mut mean) = (0.0f64, 0.0);
-            for &rgb in &colours {
-                let s = table.lookup(rgb);
-                let e = max_err(rgb, reflectance_to_rgb(|l| s.eval(l)));
-                worst = worst.max(e);
-                mean += e / colours.len() as f64;
-            }
-            println!(
-                "res {res:3}: build {:8.1} ms, max err {worst:.5}, mean err {mean:.6}",
-                dt.as_secs_f64() * 1e3
-            );
-        }
     }
 }

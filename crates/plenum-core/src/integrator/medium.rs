@@ -1,41 +1,48 @@
 //! Which solids a ray is inside, so refraction uses the right pair of indices: entering a
 //! glass ball inside water bends by η_glass/η_water, and leaving it returns to water.
+//!
+//! The stack records the solids' materials, not their indices, so that an index can be
+//! looked up at the wavelength a path carries (a dispersive medium's η varies with λ).
+
+use crate::scene::MaterialId;
 
 const CAPACITY: usize = 8;
 
-/// A small fixed-capacity stack of (primitive, index of refraction): no allocation per ray.
-/// The innermost solid is last; outside everything the index is that of vacuum, 1.
+/// A small fixed-capacity stack of (primitive, material): no allocation per ray. The
+/// innermost solid is last; outside everything is vacuum.
 #[derive(Clone, Copy, Debug)]
 pub struct MediumStack {
-    entries: [(u32, f64); CAPACITY],
+    entries: [(u32, MaterialId); CAPACITY],
     len: usize,
 }
 
 impl Default for MediumStack {
     fn default() -> Self {
         MediumStack {
-            entries: [(0, 1.0); CAPACITY],
+            entries: [(0, 0); CAPACITY],
             len: 0,
         }
     }
 }
 
 impl MediumStack {
-    /// Index of refraction where the ray is now.
-    pub fn ior(&self) -> f64 {
-        if self.len == 0 {
-            1.0
-        } else {
-            self.entries[self.len - 1].1
-        }
+    /// The material of the solid the ray is in now; `None` in vacuum.
+    pub fn innermost(&self) -> Option<MaterialId> {
+        self.len.checked_sub(1).map(|i| self.entries[i].1)
     }
 
-    /// The stack after entering `primitive`. Deeper nesting than the capacity is treated as
-    /// staying in the innermost medium recorded.
-    pub fn entered(&self, primitive: u32, ior: f64) -> MediumStack {
+    /// Index of refraction where the ray is now, with `ior` giving a material's (1 in
+    /// vacuum).
+    pub fn ior(&self, ior: impl Fn(MaterialId) -> f64) -> f64 {
+        self.innermost().map_or(1.0, ior)
+    }
+
+    /// The stack after entering `primitive` of `material`. Deeper nesting than the capacity
+    /// is treated as staying in the innermost medium recorded.
+    pub fn entered(&self, primitive: u32, material: MaterialId) -> MediumStack {
         let mut s = *self;
         if s.len < CAPACITY {
-            s.entries[s.len] = (primitive, ior);
+            s.entries[s.len] = (primitive, material);
             s.len += 1;
         }
         s
@@ -58,13 +65,15 @@ mod tests {
 
     #[test]
     fn glass_inside_water() {
+        // Materials 7 (water) and 9 (glass).
+        let ior = |m: MaterialId| if m == 7 { 1.33 } else { 1.5 };
         let air = MediumStack::default();
-        let water = air.entered(1, 1.33);
-        let glass = water.entered(2, 1.5);
-        assert_eq!(glass.ior(), 1.5);
-        assert_eq!(glass.left(2).ior(), 1.33);
-        assert_eq!(glass.left(2).left(1).ior(), 1.0);
+        let water = air.entered(1, 7);
+        let glass = water.entered(2, 9);
+        assert_eq!(glass.ior(ior), 1.5);
+        assert_eq!(glass.left(2).ior(ior), 1.33);
+        assert_eq!(glass.left(2).left(1).ior(ior), 1.0);
         // Overlapping solids can be left out of order.
-        assert_eq!(glass.left(1).ior(), 1.5);
+        assert_eq!(glass.left(1).ior(ior), 1.5);
     }
 }

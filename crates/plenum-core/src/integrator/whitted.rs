@@ -215,17 +215,19 @@ impl<'a> Whitted<'a> {
         // leaves. Thin sheets (polygons, disks, open shells) have no inside: light crosses them
         // unbent, as through a pane of zero thickness, and the medium stays the same.
         let solid = self.scene.primitives[prim as usize].shape.is_closed();
+        // Whitted's model is RGB: indices at the sodium D line.
+        let ior = |m| self.scene.materials[m as usize].ior_at(589.3);
         let media_t = if kt.is_black() || !solid {
             *b.media
         } else if entering {
-            b.media.entered(prim, k.ior)
+            b.media.entered(prim, self.scene.primitives[prim as usize].material)
         } else {
             b.media.left(prim)
         };
         let (eta_i, eta_t) = if entering || !solid {
-            (b.media.ior(), k.ior)
+            (b.media.ior(ior), k.ior)
         } else {
-            (k.ior, media_t.ior())
+            (k.ior, media_t.ior(ior))
         };
         // Mirror and lens directions follow the shading normal, so smooth meshes look
         // smooth; a direction that would cross to the wrong side of the true surface falls

@@ -222,6 +222,18 @@ impl Material {
         }
     }
 
+    /// The index of refraction of a solid of this material at `lambda` nm (1 for those
+    /// that do not refract).
+    pub fn ior_at(&self, lambda: f64) -> f64 {
+        match self {
+            Material::Phong(m) => m.ior,
+            Material::Dielectric(m) => m.eta.spectrum().eval(lambda),
+            Material::ThinDielectric(m) => m.eta.spectrum().eval(lambda),
+            Material::CoatedDiffuse(m) => m.eta.spectrum().eval(lambda),
+            _ => 1.0,
+        }
+    }
+
     /// Some parameter is looked up by texture coordinates.
     pub fn needs_uv(&self) -> bool {
         match self {
