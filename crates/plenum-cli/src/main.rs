@@ -163,10 +163,15 @@ struct IntegratorArg(IntegratorKind);
 impl std::str::FromStr for IntegratorArg {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        IntegratorKind::from_name(s).map(IntegratorArg).ok_or_else(|| {
-            let names: Vec<&str> = IntegratorKind::ALL.iter().map(|k| k.name()).collect();
-            format!("unknown integrator `{s}`: expected one of {}", names.join(", "))
-        })
+        IntegratorKind::from_name(s)
+            .map(IntegratorArg)
+            .ok_or_else(|| {
+                let names: Vec<&str> = IntegratorKind::ALL.iter().map(|k| k.name()).collect();
+                format!(
+                    "unknown integrator `{s}`: expected one of {}",
+                    names.join(", ")
+                )
+            })
     }
 }
 
@@ -180,7 +185,9 @@ impl std::str::FromStr for ColorArg {
         match s {
             "spectral" => Ok(ColorArg(ColorMode::Spectral)),
             "rgb" => Ok(ColorArg(ColorMode::Rgb)),
-            _ => Err(format!("unknown colour mode `{s}`: expected spectral or rgb")),
+            _ => Err(format!(
+                "unknown colour mode `{s}`: expected spectral or rgb"
+            )),
         }
     }
 }

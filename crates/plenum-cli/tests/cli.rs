@@ -85,7 +85,9 @@ fn rgb_mode_warns_about_dispersion() {
     let o = plenum()
         .arg("render")
         .arg(&scene)
-        .args(["--width", "16", "--height", "12", "--spp", "1", "--color", "rgb", "-o"])
+        .args([
+            "--width", "16", "--height", "12", "--spp", "1", "--color", "rgb", "-o",
+        ])
         .arg(tmp.path().join("x.png"))
         .output()
         .unwrap();

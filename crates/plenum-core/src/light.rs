@@ -11,11 +11,11 @@
 use crate::color::Color;
 use crate::environment::EnvironmentMap;
 use crate::geometry::Shape;
-use std::sync::Arc;
 use crate::math::{Transform, Vec3};
 use crate::sampling::{
     concentric_disk, uniform_cone, uniform_cone_pdf, uniform_sphere, uniform_triangle, Frame,
 };
+use std::sync::Arc;
 
 /// Distance attenuation f(d) = min(1, 1 / (a + b·d + c·d²)).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -158,7 +158,9 @@ impl Emitter {
                 normal: d.normal.normalized(),
                 radius: d.radius,
             }),
-            Shape::Mesh(m) => Emitter::triangles(m.triangles().map(|(_, t)| t.map(world)).collect()),
+            Shape::Mesh(m) => {
+                Emitter::triangles(m.triangles().map(|(_, t)| t.map(world)).collect())
+            }
             Shape::Polygon(p) => Emitter::triangles(fan(p.vertices())),
             Shape::Polyhedron(p) => {
                 Emitter::triangles(p.faces().iter().flat_map(|f| fan(f.vertices())).collect())
@@ -174,12 +176,42 @@ impl Emitter {
                 };
                 // Six faces, each wound so that its normal points out of the box.
                 let faces = [
-                    [v(false, false, false), v(false, true, false), v(true, true, false), v(true, false, false)],
-                    [v(false, false, true), v(true, false, true), v(true, true, true), v(false, true, true)],
-                    [v(false, false, false), v(true, false, false), v(true, false, true), v(false, false, true)],
-                    [v(false, true, false), v(false, true, true), v(true, true, true), v(true, true, false)],
-                    [v(false, false, false), v(false, false, true), v(false, true, true), v(false, true, false)],
-                    [v(true, false, false), v(true, true, false), v(true, true, true), v(true, false, true)],
+                    [
+                        v(false, false, false),
+                        v(false, true, false),
+                        v(true, true, false),
+                        v(true, false, false),
+                    ],
+                    [
+                        v(false, false, true),
+                        v(true, false, true),
+                        v(true, true, true),
+                        v(false, true, true),
+                    ],
+                    [
+                        v(false, false, false),
+                        v(true, false, false),
+                        v(true, false, true),
+                        v(false, false, true),
+                    ],
+                    [
+                        v(false, true, false),
+                        v(false, true, true),
+                        v(true, true, true),
+                        v(true, true, false),
+                    ],
+                    [
+                        v(false, false, false),
+                        v(false, false, true),
+                        v(false, true, true),
+                        v(false, true, false),
+                    ],
+                    [
+                        v(true, false, false),
+                        v(true, true, false),
+                        v(true, true, true),
+                        v(true, false, true),
+                    ],
                 ];
                 Emitter::triangles(faces.iter().flat_map(|f| fan(f)).collect())
             }

@@ -57,9 +57,14 @@ impl LightSampler {
         if self.cdf.is_empty() {
             return None;
         }
-        let i = self.cdf.partition_point(|&c| c <= u).min(self.cdf.len() - 1);
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .min(self.cdf.len() - 1);
         // Skip lights of probability 0 that the search can land on at a boundary.
-        let i = (i..self.pmf.len()).find(|&j| self.pmf[j] > 0.0).unwrap_or(i);
+        let i = (i..self.pmf.len())
+            .find(|&j| self.pmf[j] > 0.0)
+            .unwrap_or(i);
         Some((i as u32, self.pmf[i]))
     }
 
@@ -91,7 +96,10 @@ mod tests {
             counts[i as usize] += 1;
         }
         // Binomial standard deviation at p = 0.25 is 137 of 100 000; allow 5σ.
-        assert!((counts[0] as f64 - 0.25 * n as f64).abs() < 700.0, "{counts:?}");
+        assert!(
+            (counts[0] as f64 - 0.25 * n as f64).abs() < 700.0,
+            "{counts:?}"
+        );
         assert_eq!(counts[1] + counts[3], 0);
     }
 

@@ -311,7 +311,16 @@ fn render_pixel(
         None => {
             let mut e = PixelEstimate::default();
             let all = 0..settings.sampler.samples_per_pixel();
-            sample_pixel(integrator, camera, settings, (x, y), all, &mut e, counts, tree);
+            sample_pixel(
+                integrator,
+                camera,
+                settings,
+                (x, y),
+                all,
+                &mut e,
+                counts,
+                tree,
+            );
             e.value()
         }
     }
@@ -373,7 +382,16 @@ fn refine_pixel(
             return;
         }
         let (c, t) = (&mut *counts, tree.as_deref_mut());
-        sample_pixel(integrator, camera, settings, pixel, start..end, estimate, c, t);
+        sample_pixel(
+            integrator,
+            camera,
+            settings,
+            pixel,
+            start..end,
+            estimate,
+            c,
+            t,
+        );
         if estimate.converged(threshold) {
             return;
         }

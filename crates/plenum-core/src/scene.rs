@@ -2,17 +2,17 @@
 //! Built once by [`SceneBuilder`]; immutable and shared by every render thread.
 
 use crate::accel::{Accel, AccelKind, Coherence, LeafSize};
+use crate::bxdf::Bsdf;
 use crate::camera::CameraSettings;
 use crate::color::Color;
 use crate::geometry::{Disk, HitRecord, Polygon, Shape, Sphere, TriangleMesh};
 use crate::light::{Emitter, Light};
-use crate::bxdf::Bsdf;
 use crate::light_sampler::{LightSampler, LightSamplerKind};
 use crate::material::{Coefficients, Material, Scattering, SpectrumKind, SpectrumValue};
-use crate::sampling::Rng;
-use plenum_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 use crate::math::{gamma, Bounds3, Motion, Ray, Transform, Vec3};
+use crate::sampling::Rng;
 use crate::texture::TextureCoords;
+use plenum_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 use std::sync::Arc;
 
 /// Index of a material in [`Scene::materials`].
@@ -784,7 +784,9 @@ impl SceneBuilder {
             .iter()
             .zip(&self.light_spectra)
             .map(|(l, s)| match s {
-                Some((s, scale)) => SpectrumValue::new(crate::material::scaled(s, *scale), SpectrumKind::Illuminant),
+                Some((s, scale)) => {
+                    SpectrumValue::new(crate::material::scaled(s, *scale), SpectrumKind::Illuminant)
+                }
                 None => SpectrumValue::from_rgb(l.rgb(), SpectrumKind::Illuminant),
             })
             .collect();

@@ -21,7 +21,8 @@ pub fn parse_mtl(
     let mut out = HashMap::new();
     let mut warnings = Vec::new();
     let mut current: Option<(String, PhongMaterial, f64)> = None;
-    let finish = |c: Option<(String, PhongMaterial, f64)>, out: &mut HashMap<String, PhongMaterial>| {
+    let finish = |c: Option<(String, PhongMaterial, f64)>,
+                  out: &mut HashMap<String, PhongMaterial>| {
         if let Some((name, mut m, illum)) = c {
             let illum = illum as i32;
             if matches!(illum, 3 | 5 | 7) {

@@ -9,8 +9,8 @@ use plenum_core::geometry::{
     Cone, Cuboid, Cylinder, Disk, Plane, Polygon, Polyhedron, Shape, Sphere, TriangleMesh,
 };
 use plenum_core::integrator::{ColorMode, IntegratorKind, MAX_DEPTH};
-use plenum_core::light_sampler::LightSamplerKind;
 use plenum_core::light::{Attenuation, Emitter, Light};
+use plenum_core::light_sampler::LightSamplerKind;
 use plenum_core::material::PhongMaterial;
 use plenum_core::math::{Matrix4, Transform, Vec3};
 use plenum_core::sampling::MAX_SPP;
@@ -572,7 +572,14 @@ impl<'s> Reader<'s> {
                 let f = self.src.table(
                     v,
                     &what,
-                    &["type", "name", "direction", "color", "intensity", "spectrum"],
+                    &[
+                        "type",
+                        "name",
+                        "direction",
+                        "color",
+                        "intensity",
+                        "spectrum",
+                    ],
                 )?;
                 let light = Light::Directional {
                     direction: f.direction("direction", None)?.normalized(),
@@ -624,10 +631,18 @@ impl<'s> Reader<'s> {
                     "disk" => &["center", "normal", "radius"],
                     _ => &["center", "radius"],
                 };
-                let keys: Vec<&str> = ["type", "name", "color", "intensity", "spectrum", "samples", "two_sided"]
-                    .into_iter()
-                    .chain(shape_keys.iter().copied())
-                    .collect();
+                let keys: Vec<&str> = [
+                    "type",
+                    "name",
+                    "color",
+                    "intensity",
+                    "spectrum",
+                    "samples",
+                    "two_sided",
+                ]
+                .into_iter()
+                .chain(shape_keys.iter().copied())
+                .collect();
                 let f = self.src.table(v, &what, &keys)?;
                 let emitter = match kind.as_str() {
                     "rectangle" => {
@@ -668,14 +683,25 @@ impl<'s> Reader<'s> {
                 let f = self.src.table(
                     v,
                     &what,
-                    &["type", "name", "color", "intensity", "spectrum", "file", "layout", "up"],
+                    &[
+                        "type",
+                        "name",
+                        "color",
+                        "intensity",
+                        "spectrum",
+                        "file",
+                        "layout",
+                        "up",
+                    ],
                 )?;
                 if let Some(file) = f.get("file") {
                     for key in ["color", "spectrum"] {
                         if let Some(c) = f.get(key) {
                             return Err(self.src.error(
                                 c.span(),
-                                format!("an environment map gives the light's radiance: drop `{key}`"),
+                                format!(
+                                    "an environment map gives the light's radiance: drop `{key}`"
+                                ),
                             ));
                         }
                     }
@@ -701,7 +727,11 @@ impl<'s> Reader<'s> {
 
     /// An emitter's radiance: an RGB colour, or a spectrum (whose RGB value is then worked
     /// out by the scene); times `scale`.
-    fn emission(&self, v: &Value<'s>, scale: f64) -> Result<(Color, Option<plenum_spectrum::Spectrum>)> {
+    fn emission(
+        &self,
+        v: &Value<'s>,
+        scale: f64,
+    ) -> Result<(Color, Option<plenum_spectrum::Spectrum>)> {
         match v.get_ref() {
             DeValue::String(_) | DeValue::Table(_) => Ok((Color::BLACK, Some(self.spectrum(v)?))),
             _ => Ok((self.non_negative(v, self.color(v)?)? * scale, None)),
@@ -732,8 +762,15 @@ impl<'s> Reader<'s> {
         let up = f.direction("up", Some(Vec3::Y))?.normalized();
         let scale = f.non_negative_or("intensity", 1.0)?;
         let frame = plenum_core::sampling::Frame::from_z(up);
-        let map = EnvironmentMap::new(image.width as usize, image.height as usize, image.pixels, layout, frame, scale)
-            .map_err(|e| self.src.error(file.span(), e))?;
+        let map = EnvironmentMap::new(
+            image.width as usize,
+            image.height as usize,
+            image.pixels,
+            layout,
+            frame,
+            scale,
+        )
+        .map_err(|e| self.src.error(file.span(), e))?;
         let [r, g, b] = map.average();
         Ok(Light::Environment {
             map: plenum_core::light::EnvironmentLight {
@@ -863,8 +900,12 @@ impl<'s> Reader<'s> {
             ],
         };
         const EMISSION: [&str; 4] = ["emission", "emission_scale", "two_sided", "light_samples"];
-        let allowed: Vec<&'static str> =
-            COMMON.iter().chain(fields).chain(&EMISSION).copied().collect();
+        let allowed: Vec<&'static str> = COMMON
+            .iter()
+            .chain(fields)
+            .chain(&EMISSION)
+            .copied()
+            .collect();
         let f = self.src.table(v, &kind, &allowed)?;
         let (shape, frame) = self.shape(&kind, &f)?;
         let placement = match f.get("transform") {
@@ -888,9 +929,10 @@ impl<'s> Reader<'s> {
                 ));
             }
             if close.is_some() {
-                return Err(self
-                    .src
-                    .error(e.span(), "an emitting object cannot move (`transform_close`)"));
+                return Err(self.src.error(
+                    e.span(),
+                    "an emitting object cannot move (`transform_close`)",
+                ));
             }
             let scale = f.non_negative_or("emission_scale", 1.0)?;
             let (radiance, spectrum) = self.emission(e, scale)?;
@@ -962,7 +1004,9 @@ impl<'s> Reader<'s> {
             if let Some(&id) = self.materials.get("default") {
                 return Ok(id);
             }
-            let id = self.builder.add_material("default", PhongMaterial::default());
+            let id = self
+                .builder
+                .add_material("default", PhongMaterial::default());
             self.materials.insert("default".into(), id);
             return Ok(id);
         };

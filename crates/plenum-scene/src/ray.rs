@@ -1150,7 +1150,10 @@ mod tests {
         // B: reflective defaults to zero; missing coefficients are 0, 0, 1.
         let b = "SBT-raytracer 1.0\npoint_light { position = (0, 0, 1); colour = (1, 1, 1); constant_attenuation_coeff = 0.25; }\nsphere { material = { specular = (0.5, 0.5, 0.5); shininess = 0.5; }; }\n";
         let (scene, _, _) = read(b).unwrap();
-        assert_eq!(constant(&scene.materials[0].phong().unwrap().reflective), Color::BLACK);
+        assert_eq!(
+            constant(&scene.materials[0].phong().unwrap().reflective),
+            Color::BLACK
+        );
         assert_eq!(scene.materials[0].phong().unwrap().shininess, 64.0);
         match &scene.lights[0] {
             Light::Point { attenuation, .. } => assert_eq!(
@@ -1166,7 +1169,10 @@ mod tests {
         // A (a named top-level material): reflective = specular; lights without falloff.
         let a = "SBT-raytracer 1.0\nmaterial { name = \"shiny\"; specular = (0.5, 0.5, 0.5); shininess = 76.8; }\npoint_light { position = (0, 0, 1); color = (1, 1, 1); }\nsphere { material = shiny; }\n";
         let (scene, _, _) = read(a).unwrap();
-        assert_eq!(constant(&scene.materials[0].phong().unwrap().reflective), Color::gray(0.5));
+        assert_eq!(
+            constant(&scene.materials[0].phong().unwrap().reflective),
+            Color::gray(0.5)
+        );
         assert_eq!(scene.materials[0].phong().unwrap().shininess, 76.8);
         match &scene.lights[0] {
             Light::Point { attenuation, .. } => assert_eq!(*attenuation, Attenuation::default()),

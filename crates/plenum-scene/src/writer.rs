@@ -4,14 +4,14 @@
 //! by several objects are written once, as `[meshes.NAME]`.
 
 use crate::RenderDefaults;
-use plenum_core::material::{ConductorSpec, FloatTexture, Material, Roughness, SpectralTexture};
-use plenum_spectrum::Spectrum;
 use plenum_core::color::Color;
 use plenum_core::geometry::Shape;
 use plenum_core::light::{Attenuation, Emitter, Light};
+use plenum_core::material::{ConductorSpec, FloatTexture, Material, Roughness, SpectralTexture};
 use plenum_core::math::{Transform, Vec3};
 use plenum_core::scene::Scene;
 use plenum_core::texture::Texture;
+use plenum_spectrum::Spectrum;
 use std::collections::HashMap;
 use std::fmt::Write;
 
@@ -330,8 +330,8 @@ fn written_with_object(scene: &Scene, light: usize) -> bool {
     let Some(prim) = scene.light_objects[light] else {
         return false;
     };
-    let emitter_only = scene.materials[scene.primitives[prim as usize].material as usize]
-        .is_emitter_only();
+    let emitter_only =
+        scene.materials[scene.primitives[prim as usize].material as usize].is_emitter_only();
     let mesh = matches!(scene.primitives[prim as usize].shape, Shape::Mesh(_));
     mesh || !emitter_only
 }

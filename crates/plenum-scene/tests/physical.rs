@@ -37,7 +37,10 @@ fn path_settings(l: &LoadedScene, spp: u32, color: ColorMode, seed: u64) -> Rend
 
 fn draw(l: &LoadedScene, settings: &RenderSettings) -> Vec<[f32; 3]> {
     let out = render(&l.scene, settings, &AtomicBool::new(false), &|_, _| {});
-    assert_eq!(out.counts.invalid, 0, "no sample may come out NaN or infinite");
+    assert_eq!(
+        out.counts.invalid, 0,
+        "no sample may come out NaN or infinite"
+    );
     out.film.pixels().to_vec()
 }
 
@@ -96,14 +99,17 @@ fn furnace_scenes_converge_to_radiance_one() {
         ),
         (
             "four point lights of intensity π/4",
-            [[0.1, 0.0, 0.0], [-0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, -0.1, 0.0]]
-                .iter()
-                .map(|p| {
-                    format!(
-                        "[[lights]]\ntype = \"point\"\nposition = {p:?}\nintensity = {quarter}\n"
-                    )
-                })
-                .collect(),
+            [
+                [0.1, 0.0, 0.0],
+                [-0.1, 0.0, 0.0],
+                [0.0, 0.1, 0.0],
+                [0.0, -0.1, 0.0],
+            ]
+            .iter()
+            .map(|p| {
+                format!("[[lights]]\ntype = \"point\"\nposition = {p:?}\nintensity = {quarter}\n")
+            })
+            .collect(),
             String::new(),
         ),
         (
@@ -166,7 +172,9 @@ faces = [[0, 2, 1], [3, 4, 5], [0, 1, 4, 3], [1, 2, 5, 4], [2, 0, 3, 5]]
         );
         let mut ray = Ray::new(Vec3::new(-0.5, 0.2886751345948129, 0.0) - d0 * 2.0, d0);
         for interface in 0..2 {
-            let (prim, hit) = s.intersect(&ray, f64::INFINITY).expect("the beam meets the prism");
+            let (prim, hit) = s
+                .intersect(&ray, f64::INFINITY)
+                .expect("the beam meets the prism");
             let it = s.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
             let bsdf = s.bsdf(&it, wo, &mut wl).expect("glass scatters");
@@ -178,7 +186,10 @@ faces = [[0, 2, 1], [3, 4, 5], [0, 1, 4, 3], [1, 2, 5, 4], [2, 0, 3, 5]]
             let origin = plenum_core::math::offset_ray_origin(it.p, it.p_error, it.n, bs.wi);
             ray = Ray::new(origin, bs.wi);
         }
-        assert!(wl.secondary_terminated(), "dispersion keeps only the hero wavelength");
+        assert!(
+            wl.secondary_terminated(),
+            "dispersion keeps only the hero wavelength"
+        );
         // Snell twice: in at 50° on the left face, out through the right face (apex 60°).
         let n = eta.eval(lambda);
         let inside = (incidence.sin() / n).asin();
@@ -222,7 +233,8 @@ fn cbox_z_test(color: ColorMode, reference: &str, variance: &str) {
         return;
     };
     let (reference, ref_var) = (read_exr(&r), read_exr(&v));
-    let scene_file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
+    let scene_file =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
     let l = load_scene(&scene_file).unwrap_or_else(|e| panic!("{e}"));
     let (renders, spp) = (16u64, 16);
     let images: Vec<Vec<[f32; 3]>> = (0..renders)
@@ -237,8 +249,8 @@ fn cbox_z_test(color: ColorMode, reference: &str, variance: &str) {
         for c in 0..3 {
             let xs: Vec<f64> = images.iter().map(|im| im[i][c] as f64).collect();
             let m = xs.iter().sum::<f64>() / renders as f64;
-            let var = xs.iter().map(|x| (x - m).powi(2)).sum::<f64>()
-                / ((renders - 1) * renders) as f64;
+            let var =
+                xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / ((renders - 1) * renders) as f64;
             let d = m - reference[i][c] as f64;
             let total = var + ref_var[i][c] as f64;
             if total == 0.0 && d == 0.0 || d.abs() <= z_max * total.sqrt() {
@@ -256,7 +268,10 @@ fn cbox_z_test(color: ColorMode, reference: &str, variance: &str) {
         100.0 * rate
     );
     assert!(rate >= 0.9975, "only {:.3} % passed", 100.0 * rate);
-    assert!((0.8..=1.25).contains(&ratio), "squared error is {ratio} × what noise predicts");
+    assert!(
+        (0.8..=1.25).contains(&ratio),
+        "squared error is {ratio} × what noise predicts"
+    );
 }
 
 /// Φ⁻¹(p) by bisection on the complementary error function's series (erfc from
@@ -265,15 +280,17 @@ fn normal_quantile(p: f64) -> f64 {
     let erfc = |x: f64| {
         let z = x.abs();
         let t = 1.0 / (1.0 + 0.5 * z);
-        let r = t * (-z * z - 1.26551223
-            + t * (1.00002368
-                + t * (0.37409196
-                    + t * (0.09678418
-                        + t * (-0.18628806
-                            + t * (0.27886807
-                                + t * (-1.13520398
-                                    + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
-            .exp();
+        let r = t
+            * (-z * z - 1.26551223
+                + t * (1.00002368
+                    + t * (0.37409196
+                        + t * (0.09678418
+                            + t * (-0.18628806
+                                + t * (0.27886807
+                                    + t * (-1.13520398
+                                        + t * (1.48851587
+                                            + t * (-0.82215223 + t * 0.17087277)))))))))
+                .exp();
         if x >= 0.0 {
             r
         } else {
@@ -340,7 +357,10 @@ fn phong_scenes_render_under_the_path_tracer() {
     for color in [ColorMode::Rgb, ColorMode::Spectral] {
         let pixels = draw(&l, &path_settings(&l, 4, color, 5));
         let m = mean(&pixels);
-        assert!(m.iter().all(|v| v.is_finite() && *v > 0.01), "{color:?}: mean {m:?}");
+        assert!(
+            m.iter().all(|v| v.is_finite() && *v > 0.01),
+            "{color:?}: mean {m:?}"
+        );
     }
 }
 
@@ -356,8 +376,14 @@ fn a_diffuse_sphere_under_a_uniform_sky() {
     plenum_image::write_image(&sky, 16, 16, &vec![[1.0f32; 3]; 256], 0.0).unwrap();
     let lights = [
         "[[lights]]\ntype = \"infinite\"\ncolor = [1, 1, 1]".to_string(),
-        format!("[[lights]]\ntype = \"infinite\"\nfile = {:?}\nlayout = \"latlong\"", sky.display().to_string()),
-        format!("[[lights]]\ntype = \"infinite\"\nfile = {:?}\nlayout = \"equalarea\"\nup = [0, 0, 1]", sky.display().to_string()),
+        format!(
+            "[[lights]]\ntype = \"infinite\"\nfile = {:?}\nlayout = \"latlong\"",
+            sky.display().to_string()
+        ),
+        format!(
+            "[[lights]]\ntype = \"infinite\"\nfile = {:?}\nlayout = \"equalarea\"\nup = [0, 0, 1]",
+            sky.display().to_string()
+        ),
     ];
     for light in lights {
         let l = scene(&format!(
@@ -392,7 +418,10 @@ material = "half"
             let corner: Vec<[f32; 3]> = [0, 15, 240, 255].iter().map(|&i| px[i]).collect();
             for (what, got, want) in [("sphere", mean(&centre), 0.5), ("sky", mean(&corner), 1.0)] {
                 for v in got {
-                    assert!((v - want).abs() <= 0.015, "{light}, {color:?}: {what} {got:?}, expected {want}");
+                    assert!(
+                        (v - want).abs() <= 0.015,
+                        "{light}, {color:?}: {what} {got:?}, expected {want}"
+                    );
                 }
             }
         }

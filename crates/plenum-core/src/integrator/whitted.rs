@@ -220,7 +220,8 @@ impl<'a> Whitted<'a> {
         let media_t = if kt.is_black() || !solid {
             *b.media
         } else if entering {
-            b.media.entered(prim, self.scene.primitives[prim as usize].material)
+            b.media
+                .entered(prim, self.scene.primitives[prim as usize].material)
         } else {
             b.media.left(prim)
         };

@@ -10,11 +10,14 @@ mod param;
 mod phong;
 mod physical;
 
-pub use param::{scaled, source_rgb, uplift, uplift_illuminant, FloatTexture, SpectralTexture, SpectrumKind, SpectrumValue};
+pub use param::{
+    scaled, source_rgb, uplift, uplift_illuminant, FloatTexture, SpectralTexture, SpectrumKind,
+    SpectrumValue,
+};
 pub use phong::{Coefficients, PhongMaterial};
 pub use physical::{
-    CoatedDiffuseMaterial, ConductorMaterial, ConductorSpec, DielectricMaterial,
-    DiffuseMaterial, DiffuseTransmissionMaterial, Roughness, ThinDielectricMaterial,
+    CoatedDiffuseMaterial, ConductorMaterial, ConductorSpec, DielectricMaterial, DiffuseMaterial,
+    DiffuseTransmissionMaterial, Roughness, ThinDielectricMaterial,
 };
 
 use crate::bxdf::{Bxdf, PhongBxdf};
@@ -277,6 +280,10 @@ fn spectrum_of(c: Color, wl: &SampledWavelengths) -> SampledSpectrum {
         SampledSpectrum([c.r, c.g, c.b, 0.0])
     } else {
         let clamp = |v: f64| v.clamp(0.0, 1.0);
-        param::uplift_at(Color::new(clamp(c.r), clamp(c.g), clamp(c.b)), SpectrumKind::Albedo, wl)
+        param::uplift_at(
+            Color::new(clamp(c.r), clamp(c.g), clamp(c.b)),
+            SpectrumKind::Albedo,
+            wl,
+        )
     }
 }

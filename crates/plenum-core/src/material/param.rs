@@ -7,10 +7,10 @@
 //! bounded by 1, indices of refraction are not, emitters are illuminants.
 
 use crate::color::Color;
-use std::sync::OnceLock;
 use crate::texture::{Texture, TextureCoords};
 use plenum_spectrum::uplift::d65_normalized;
 use plenum_spectrum::{RgbToSpectrumTable, SampledSpectrum, SampledWavelengths, Spectrum};
+use std::sync::OnceLock;
 
 /// How an RGB value becomes a spectrum.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -89,7 +89,10 @@ impl SpectrumValue {
 pub enum SpectralTexture {
     Constant(SpectrumValue),
     /// An RGB texture, uplifted per lookup.
-    Rgb { texture: Texture, kind: SpectrumKind },
+    Rgb {
+        texture: Texture,
+        kind: SpectrumKind,
+    },
 }
 
 impl SpectralTexture {
@@ -112,7 +115,11 @@ impl SpectralTexture {
             SpectralTexture::Rgb { texture, kind } => {
                 let mut c = texture.evaluate(at);
                 if *kind == SpectrumKind::Albedo {
-                    c = Color::new(c.r.clamp(0.0, 1.0), c.g.clamp(0.0, 1.0), c.b.clamp(0.0, 1.0));
+                    c = Color::new(
+                        c.r.clamp(0.0, 1.0),
+                        c.g.clamp(0.0, 1.0),
+                        c.b.clamp(0.0, 1.0),
+                    );
                 }
                 if wl.is_rgb() {
                     SampledSpectrum([c.r, c.g, c.b, 0.0])

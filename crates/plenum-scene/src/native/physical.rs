@@ -7,9 +7,9 @@ use super::Reader;
 use crate::diagnostics::did_you_mean;
 use crate::reader::{Fields, Result, Value};
 use plenum_core::material::{
-    CoatedDiffuseMaterial, ConductorMaterial, ConductorSpec, DielectricMaterial,
-    DiffuseMaterial, DiffuseTransmissionMaterial, FloatTexture, Material, Roughness,
-    SpectralTexture, SpectrumKind, SpectrumValue, ThinDielectricMaterial,
+    CoatedDiffuseMaterial, ConductorMaterial, ConductorSpec, DielectricMaterial, DiffuseMaterial,
+    DiffuseTransmissionMaterial, FloatTexture, Material, Roughness, SpectralTexture, SpectrumKind,
+    SpectrumValue, ThinDielectricMaterial,
 };
 use plenum_core::texture::Texture;
 use plenum_spectrum::Spectrum;
@@ -53,25 +53,37 @@ impl<'s> Reader<'s> {
                 })
             }
             "conductor" => {
-                let f = table(&["metal", "eta", "k", "reflectance", rough_keys[0], rough_keys[1]])?;
+                let f = table(&[
+                    "metal",
+                    "eta",
+                    "k",
+                    "reflectance",
+                    rough_keys[0],
+                    rough_keys[1],
+                ])?;
                 let spec = match (f.get("metal"), f.get("reflectance")) {
                     (Some(m), _) => {
                         if f.get("eta").is_some() || f.get("k").is_some() {
-                            return Err(self
-                                .src
-                                .error(m.span(), "give either `metal` or `eta` and `k`, not both"));
+                            return Err(self.src.error(
+                                m.span(),
+                                "give either `metal` or `eta` and `k`, not both",
+                            ));
                         }
                         let metal = self.src.string(m)?;
                         if !METALS.contains(&metal) {
                             let e = self.src.error(m.span(), format!("unknown metal `{metal}`"));
                             return Err(match did_you_mean(metal, METALS.iter().copied()) {
                                 Some(s) => e.with_help(format!("did you mean `{s}`?")),
-                                None => e.with_help(format!("expected one of: {}", METALS.join(", "))),
+                                None => {
+                                    e.with_help(format!("expected one of: {}", METALS.join(", ")))
+                                }
                             });
                         }
                         self.metal(metal)
                     }
-                    (None, Some(r)) => ConductorSpec::Reflectance(self.spectral(r, SpectrumKind::Albedo)?),
+                    (None, Some(r)) => {
+                        ConductorSpec::Reflectance(self.spectral(r, SpectrumKind::Albedo)?)
+                    }
                     // pbrt-v4's default conductor is copper.
                     (None, None) => match (f.get("eta"), f.get("k")) {
                         (None, None) => self.metal("Cu"),
@@ -107,7 +119,12 @@ impl<'s> Reader<'s> {
                 let f = table(&["reflectance", "transmittance", "scale"])?;
                 Material::DiffuseTransmission(DiffuseTransmissionMaterial {
                     reflectance: self.spectral_or(&f, "reflectance", 0.25, SpectrumKind::Albedo)?,
-                    transmittance: self.spectral_or(&f, "transmittance", 0.25, SpectrumKind::Albedo)?,
+                    transmittance: self.spectral_or(
+                        &f,
+                        "transmittance",
+                        0.25,
+                        SpectrumKind::Albedo,
+                    )?,
                     scale: f.non_negative_or("scale", 1.0)?,
                 })
             }
@@ -156,9 +173,10 @@ impl<'s> Reader<'s> {
                 let list = f.required("materials")?;
                 let items = self.src.array(list, "two material names")?;
                 if items.len() != 2 {
-                    return Err(self
-                        .src
-                        .error(list.span(), format!("expected two materials, found {}", items.len())));
+                    return Err(self.src.error(
+                        list.span(),
+                        format!("expected two materials, found {}", items.len()),
+                    ));
                 }
                 // Materials must be defined before the mix that uses them, so mixes cannot
                 // form a cycle.
@@ -170,9 +188,10 @@ impl<'s> Reader<'s> {
                         Texture::Constant(c) => {
                             let a = (c.r + c.g + c.b) / 3.0;
                             if !(0.0..=1.0).contains(&a) {
-                                return Err(self
-                                    .src
-                                    .error(v.span(), format!("expected an amount between 0 and 1, found {a}")));
+                                return Err(self.src.error(
+                                    v.span(),
+                                    format!("expected an amount between 0 and 1, found {a}"),
+                                ));
                             }
                             FloatTexture::Constant(a)
                         }
@@ -193,7 +212,10 @@ impl<'s> Reader<'s> {
         if !self.materials.contains_key(name) {
             return Err(self
                 .src
-                .error(v.span(), format!("no material named `{name}` is defined before this mix"))
+                .error(
+                    v.span(),
+                    format!("no material named `{name}` is defined before this mix"),
+                )
                 .with_help("define the mixed materials above the mix"));
         }
         self.material_ref(Some(v))
@@ -216,13 +238,18 @@ impl<'s> Reader<'s> {
     /// 1.5 when not given.
     fn eta(&self, f: &Fields<'_, 's>) -> Result<SpectrumValue> {
         let Some(v) = f.get("eta") else {
-            return Ok(SpectrumValue::new(Spectrum::Constant(1.5), SpectrumKind::Unbounded));
+            return Ok(SpectrumValue::new(
+                Spectrum::Constant(1.5),
+                SpectrumKind::Unbounded,
+            ));
         };
         let s = match v.get_ref() {
             DeValue::Integer(_) | DeValue::Float(_) => {
                 let e = self.src.number(v)?;
                 if e <= 0.0 {
-                    return Err(self.src.error(v.span(), format!("expected an index η > 0, found {e}")));
+                    return Err(self
+                        .src
+                        .error(v.span(), format!("expected an index η > 0, found {e}")));
                 }
                 Spectrum::Constant(e)
             }
@@ -266,7 +293,10 @@ impl<'s> Reader<'s> {
             _ => false,
         };
         if is_spectrum {
-            return Ok(SpectralTexture::Constant(SpectrumValue::new(self.spectrum(v)?, kind)));
+            return Ok(SpectralTexture::Constant(SpectrumValue::new(
+                self.spectrum(v)?,
+                kind,
+            )));
         }
         Ok(SpectralTexture::from_texture(self.texture(v)?, kind))
     }
@@ -295,7 +325,9 @@ impl<'s> Reader<'s> {
             DeValue::String(_) => {
                 let name = self.src.string(v)?;
                 plenum_spectrum::named(name).ok_or_else(|| {
-                    let e = self.src.error(v.span(), format!("unknown spectrum `{name}`"));
+                    let e = self
+                        .src
+                        .error(v.span(), format!("unknown spectrum `{name}`"));
                     match did_you_mean(name, plenum_spectrum::names().iter().copied()) {
                         Some(s) => e.with_help(format!("did you mean `{s}`?")),
                         None => e.with_help("see docs/spectra.md for the named spectra"),
@@ -303,7 +335,9 @@ impl<'s> Reader<'s> {
                 })
             }
             DeValue::Table(_) => {
-                let f = self.src.table(v, "a spectrum", &["blackbody", "spectrum"])?;
+                let f = self
+                    .src
+                    .table(v, "a spectrum", &["blackbody", "spectrum"])?;
                 if f.get("blackbody").is_some() {
                     let t = f.positive("blackbody", None)?;
                     return Ok(Spectrum::blackbody(t, 1.0));
@@ -312,7 +346,9 @@ impl<'s> Reader<'s> {
                 let items = self.src.array(list, "[wavelength in nm, value] pairs")?;
                 let mut pairs = Vec::with_capacity(items.len());
                 for item in items {
-                    let [l, x] = self.src.numbers::<2>(item, "a [wavelength in nm, value] pair")?;
+                    let [l, x] = self
+                        .src
+                        .numbers::<2>(item, "a [wavelength in nm, value] pair")?;
                     pairs.push((l, x));
                 }
                 Spectrum::piecewise(&pairs).map_err(|e| self.src.error(list.span(), e))
