@@ -11,6 +11,7 @@ mod trace;
 use clap::{Args, Parser, Subcommand};
 use plenum_core::accel::AccelKind;
 use plenum_core::integrator::{ColorMode, IntegratorConfig, IntegratorKind, MAX_DEPTH};
+use plenum_core::light_sampler::LightSamplerKind;
 use plenum_core::render::{render, Adaptive, RenderSettings, MAX_SUBDIVISION};
 use plenum_core::sampling::{Filter, FilterKind, PixelSampler, SamplerKind, MAX_SPP};
 use plenum_scene::{builtin_scene, load_scene, LoadedScene};
@@ -109,6 +110,10 @@ struct ViewArgs {
     /// Path tracing: Russian roulette from this many bounces on (default 5).
     #[arg(long)]
     rr_depth: Option<u32>,
+    /// Path tracing: how next-event estimation picks a light: power (in proportion to its
+    /// power; the default) or uniform.
+    #[arg(long)]
+    light_sampler: Option<LightSamplerArg>,
     /// Random seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -172,6 +177,21 @@ impl std::str::FromStr for IntegratorArg {
                     names.join(", ")
                 )
             })
+    }
+}
+
+/// `--light-sampler`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct LightSamplerArg(LightSamplerKind);
+
+impl std::str::FromStr for LightSamplerArg {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "power" => Ok(LightSamplerArg(LightSamplerKind::Power)),
+            "uniform" => Ok(LightSamplerArg(LightSamplerKind::Uniform)),
+            _ => Err(format!("unknown light sampler `{s}`: expected power or uniform")),
+        }
     }
 }
 
@@ -370,7 +390,7 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
         .or(d.integrator)
         .unwrap_or_else(|| loaded.scene.default_integrator());
     let color = view.color.map(|a| a.0).or(d.color).unwrap_or_default();
-    let light_sampler = d.light_sampler;
+    let light_sampler = view.light_sampler.map_or(d.light_sampler, |a| a.0);
     loaded.scene.set_light_sampler(light_sampler);
     if method != IntegratorKind::Whitted && color == ColorMode::Rgb {
         if let Some(what) = loaded.scene.needs_wavelengths() {

@@ -170,6 +170,9 @@ pub struct Scene {
     pub light_objects: Vec<Option<u32>>,
     /// Per primitive: some light can pass through (a transmissive material or vertex material).
     transmissive: Vec<bool>,
+    /// Per material: it scatters only on the side its surface's normal points to (Mitsuba's
+    /// convention; pbrt's, the default, scatters on both).
+    one_sided: Vec<bool>,
     /// Per primitive: its material looks something up by texture coordinates.
     needs_uv: Vec<bool>,
     /// I_a: the sum of the scene's ambient lights.
@@ -456,6 +459,9 @@ impl Scene {
             return self.bsdf_of(&phong, it, wl, solid, 0.5);
         }
         let mut id = p.material;
+        if self.one_sided[id as usize] && wo.dot(it.n) < 0.0 {
+            return None;
+        }
         let mut rng = Rng::new(hash_hit(it.p, wo), 0);
         // Mixes of mixes, a few deep; a cycle (which the scene reader refuses) ends here.
         for _ in 0..16 {
@@ -507,6 +513,7 @@ pub struct SceneBuilder {
     light_objects: Vec<Option<u32>>,
     /// Per light: a spectrum given in place of its RGB value, and a scale.
     light_spectra: Vec<Option<(Spectrum, f64)>>,
+    one_sided: Vec<MaterialId>,
     light_sampler: LightSamplerKind,
 }
 
@@ -534,6 +541,13 @@ impl SceneBuilder {
         if let Some(Light::Area { two_sided, .. }) = self.lights.last_mut() {
             *two_sided = false;
         }
+    }
+
+    /// Makes material `id` scatter only on the side its surfaces' normals point to (seen
+    /// from behind it is black), as Mitsuba's BSDFs do. Transmissive materials stay
+    /// two-sided.
+    pub fn set_one_sided(&mut self, id: MaterialId) {
+        self.one_sided.push(id);
     }
 
     /// How next-event estimation chooses lights (by power unless told).
@@ -799,7 +813,14 @@ impl SceneBuilder {
         let infinite_lights = (0..self.lights.len() as u32)
             .filter(|&i| self.lights[i as usize].is_infinite())
             .collect();
+        let mut one_sided = vec![false; self.materials.len()];
+        for &id in &self.one_sided {
+            if let Some(o) = one_sided.get_mut(id as usize) {
+                *o = !self.materials[id as usize].is_transmissive();
+            }
+        }
         let mut scene = Scene {
+            one_sided,
             background_spectrum: SpectrumValue::from_rgb(self.background, SpectrumKind::Illuminant),
             light_spectra,
             primitive_lights,

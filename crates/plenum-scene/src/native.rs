@@ -463,7 +463,17 @@ impl<'s> Reader<'s> {
             if t.get("type").is_some() {
                 let kind = self.kind(v, &format!("material `{name}`"), physical::MATERIAL_TYPES)?;
                 if let Some(m) = self.physical_material(name, &kind, v)? {
+                    let two_sided = match t.get("two_sided") {
+                        Some(b) => match b.get_ref() {
+                            DeValue::Boolean(b) => *b,
+                            _ => return Err(self.src.error(b.span(), "expected true or false")),
+                        },
+                        None => true,
+                    };
                     let id = self.builder.add_material(name, m);
+                    if !two_sided {
+                        self.builder.set_one_sided(id);
+                    }
                     self.materials.insert(name.to_string(), id);
                     return Ok(());
                 }

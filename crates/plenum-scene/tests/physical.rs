@@ -470,3 +470,37 @@ two_sided = false
         IntegratorKind::Whitted
     );
 }
+
+/// A mix of reflectances 0.3 and 0.7 half and half is, on average, reflectance 0.5: in the
+/// furnace sphere lit by its own emission 0.5 it converges to radiance 1 (±0.01). Made
+/// one-sided, the sphere seen from inside is black but for its emission, 0.5.
+#[test]
+fn mixes_average_and_one_sided_surfaces_are_black_behind() {
+    let mix = r#"
+[materials.dark]
+type = "diffuse"
+reflectance = 0.3
+[materials.bright]
+type = "diffuse"
+reflectance = 0.7
+[materials.half]
+type = "mix"
+materials = ["dark", "bright"]
+amount = 0.5
+"#;
+    let text = furnace("", "emission = [0.5, 0.5, 0.5]").replace(
+        "[materials.half]\ntype = \"diffuse\"\nreflectance = 0.5\n",
+        mix,
+    );
+    let l = scene(&text);
+    let m = mean(&draw(&l, &path_settings(&l, 256, ColorMode::Rgb, 4)));
+    assert!(m.iter().all(|v| (v - 1.0).abs() <= 0.01), "mix: {m:?}");
+
+    let one_sided = furnace("", "emission = [0.5, 0.5, 0.5]").replace(
+        "type = \"diffuse\"\nreflectance = 0.5\n",
+        "type = \"diffuse\"\nreflectance = 0.5\ntwo_sided = false\n",
+    );
+    let l = scene(&one_sided);
+    let m = mean(&draw(&l, &path_settings(&l, 16, ColorMode::Rgb, 4)));
+    assert!(m.iter().all(|v| (v - 0.5).abs() <= 1e-6), "one-sided: {m:?}");
+}

@@ -28,16 +28,19 @@ impl SampledSpectrum {
     pub const ONE: SampledSpectrum = SampledSpectrum([1.0; N_SAMPLES]);
 
     /// `v` in every lane.
+    #[inline]
     pub const fn splat(v: f64) -> Self {
         SampledSpectrum([v; N_SAMPLES])
     }
 
     /// `f` applied to each lane.
+    #[inline]
     pub fn map(self, f: impl Fn(f64) -> f64) -> Self {
         SampledSpectrum(self.0.map(f))
     }
 
     /// `f` applied lane by lane to `self` and `o`.
+    #[inline]
     pub fn zip(self, o: Self, f: impl Fn(f64, f64) -> f64) -> Self {
         let mut r = self;
         for i in 0..N_SAMPLES {
@@ -47,46 +50,55 @@ impl SampledSpectrum {
     }
 
     /// Every lane is 0.
+    #[inline]
     pub fn is_black(&self) -> bool {
         self.0.iter().all(|&v| v == 0.0)
     }
 
     /// The largest lane.
+    #[inline]
     pub fn max_value(&self) -> f64 {
         self.0.iter().copied().fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// The smallest lane.
+    #[inline]
     pub fn min_value(&self) -> f64 {
         self.0.iter().copied().fold(f64::INFINITY, f64::min)
     }
 
     /// The mean of the lanes (in RGB mode the unused lane counts as 0).
+    #[inline]
     pub fn average(&self) -> f64 {
         self.0.iter().sum::<f64>() / N_SAMPLES as f64
     }
 
     /// Every value is finite (no NaN, no infinity).
+    #[inline]
     pub fn is_finite(&self) -> bool {
         self.0.iter().all(|v| v.is_finite())
     }
 
     /// self / o, with 0 wherever o is 0 (pbrt's `SafeDiv`).
+    #[inline]
     pub fn safe_div(self, o: Self) -> Self {
         self.zip(o, |a, b| if b != 0.0 { a / b } else { 0.0 })
     }
 
     /// Square root per lane, negatives taken as 0.
+    #[inline]
     pub fn sqrt(self) -> Self {
         self.map(|v| v.max(0.0).sqrt())
     }
 
     /// e^x per lane (transmittance from optical depth).
+    #[inline]
     pub fn exp(self) -> Self {
         self.map(f64::exp)
     }
 
     /// Negative lanes set to 0.
+    #[inline]
     pub fn clamp_zero(self) -> Self {
         self.map(|v| v.max(0.0))
     }
@@ -186,6 +198,7 @@ impl SampledWavelengths {
     /// RGB mode: the lanes are channels. `lambda` reports a representative wavelength per
     /// channel for anything that must pick one (all at the sodium D line, 589.3 nm, so a
     /// dispersive medium in RGB mode takes its usual tabulated index).
+    #[inline]
     pub fn rgb() -> Self {
         SampledWavelengths {
             lambda: [589.3; N_SAMPLES],
@@ -195,6 +208,7 @@ impl SampledWavelengths {
     }
 
     /// Wavelengths and pdfs as given (tests and tools).
+    #[inline]
     pub fn from_parts(lambda: [f64; N_SAMPLES], pdf: [f64; N_SAMPLES]) -> Self {
         SampledWavelengths {
             lambda,
@@ -204,6 +218,7 @@ impl SampledWavelengths {
     }
 
     /// Uniform over [min, max]: the hero at u, the others equally spaced, wrapping around.
+    #[inline]
     pub fn sample_uniform(u: f64, min: f64, max: f64) -> Self {
         let delta = (max - min) / N_SAMPLES as f64;
         let mut lambda = [0.0; N_SAMPLES];
@@ -221,6 +236,7 @@ impl SampledWavelengths {
     /// other [`N_SAMPLES`] − 1 from `u + i/N` wrapped into [0, 1), each mapped the same way, so
     /// the lanes are stratified over the visible density (pbrt-v4's `SampleVisible`).
     /// Every lane's pdf (per nm) is its own [`visible_pdf`].
+    #[inline]
     pub fn sample_visible(u: f64) -> Self {
         let mut lambda = [0.0; N_SAMPLES];
         let mut pdf = [0.0; N_SAMPLES];
@@ -236,21 +252,25 @@ impl SampledWavelengths {
     }
 
     /// Spectral or RGB.
+    #[inline]
     pub fn mode(&self) -> ColorMode {
         self.mode
     }
 
     /// Whether the lanes are RGB channels.
+    #[inline]
     pub fn is_rgb(&self) -> bool {
         self.mode == ColorMode::Rgb
     }
 
     /// The wavelengths, nm (589.3 in every lane in RGB mode).
+    #[inline]
     pub fn lambda(&self) -> &[f64; N_SAMPLES] {
         &self.lambda
     }
 
     /// The sampling densities, per nm (RGB mode: 1, 1, 1, 0).
+    #[inline]
     pub fn pdf(&self) -> SampledSpectrum {
         SampledSpectrum(self.pdf)
     }
@@ -259,6 +279,7 @@ impl SampledWavelengths {
     /// goes on: the others get pdf 0 and the hero's pdf is divided by N, since the path could
     /// have been started by any of the N (pbrt-v4's `TerminateSecondary`). Nothing happens in
     /// RGB mode or when already terminated.
+    #[inline]
     pub fn terminate_secondary(&mut self) {
         if self.is_rgb() || self.secondary_terminated() {
             return;
@@ -270,6 +291,7 @@ impl SampledWavelengths {
     }
 
     /// Whether only the hero wavelength still carries the path.
+    #[inline]
     pub fn secondary_terminated(&self) -> bool {
         !self.is_rgb() && self.pdf[1..].iter().all(|&p| p == 0.0)
     }

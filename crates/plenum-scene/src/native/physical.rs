@@ -42,7 +42,7 @@ impl<'s> Reader<'s> {
         let rough_keys = ["roughness", "remap_roughness"];
         let src = self.src;
         let table = |keys: &[&'static str]| {
-            let all: Vec<&'static str> = ["type"].iter().chain(keys).copied().collect();
+            let all: Vec<&'static str> = ["type", "two_sided"].iter().chain(keys).copied().collect();
             src.table(v, &what, &all)
         };
         Ok(Some(match kind {
