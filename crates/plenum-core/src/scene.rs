@@ -462,10 +462,17 @@ impl Scene {
         if self.one_sided[id as usize] && wo.dot(it.n) < 0.0 {
             return None;
         }
-        let mut rng = Rng::new(hash_hit(it.p, wo), 0);
         // Mixes of mixes, a few deep; a cycle (which the scene reader refuses) ends here.
+        let mut rng = None;
         for _ in 0..16 {
-            match self.materials[id as usize].scattering(&it.texture, wl, solid, rng.uniform()) {
+            let m = &self.materials[id as usize];
+            let u = match m {
+                Material::Mix { .. } => rng
+                    .get_or_insert_with(|| Rng::new(hash_hit(it.p, wo), 0))
+                    .uniform(),
+                _ => 0.5,
+            };
+            match m.scattering(&it.texture, wl, solid, u) {
                 Scattering::Bxdf(b) => return self.finish_bsdf(b, it),
                 Scattering::Other(next) => id = next,
             }

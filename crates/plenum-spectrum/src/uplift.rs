@@ -308,6 +308,61 @@ fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
     x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
+/// Solves one plane of the table (`c`: the largest component) into `part`, [z][y][x].
+fn build_plane(
+    q: &Quadrature,
+    z_nodes: &[f64],
+    res: usize,
+    start: usize,
+    c: usize,
+    part: &mut [[f64; 3]],
+) {
+    let mut column_start: Option<[f64; 3]> = None;
+    for yi in 0..res {
+        let mut row_start = column_start;
+        for xi in 0..res {
+            let x = xi as f64 / (res - 1) as f64;
+            let y = yi as f64 / (res - 1) as f64;
+            let rgb_at = |z: f64| {
+                let mut rgb = [0.0; 3];
+                rgb[c] = z;
+                rgb[(c + 1) % 3] = x * z;
+                rgb[(c + 2) % 3] = y * z;
+                rgb
+            };
+            let solve = |guess: Option<[f64; 3]>, rgb: [f64; 3]| {
+                if let Some(g) = guess {
+                    let (sol, err) = q.gauss_newton(g, rgb, 20, TABLE_TOLERANCE);
+                    if err < 1e-3 {
+                        return sol;
+                    }
+                }
+                RgbSigmoid::fit(rgb).to_normalized()
+            };
+            let idx = |zi: usize| (zi * res + yi) * res + xi;
+            let first = solve(row_start, rgb_at(z_nodes[start]));
+            if xi == 0 {
+                column_start = Some(first);
+            }
+            row_start = Some(first);
+            part[idx(start)] = first;
+            let mut guess = first;
+            for zi in start + 1..res {
+                guess = solve(Some(guess), rgb_at(z_nodes[zi]));
+                part[idx(zi)] = guess;
+            }
+            guess = first;
+            for zi in (1..start).rev() {
+                guess = solve(Some(guess), rgb_at(z_nodes[zi]));
+                part[idx(zi)] = guess;
+            }
+            // z = 0 is black, which no finite sigmoid reaches: reuse the next node's
+            // (nearly black) solution.
+            part[idx(0)] = part[idx(1)];
+        }
+    }
+}
+
 /// Sigmoid coefficients tabulated over RGB in [0, 1]³ (Jakob and Hanika's parametrisation):
 /// for each choice of largest component, a `res`³ grid over that component z (at
 /// smoothstep(smoothstep(i/(res−1))), denser near 0 and 1) and the other two components
@@ -328,7 +383,8 @@ pub const SRGB_TABLE_RES: usize = 24;
 
 impl RgbToSpectrumTable {
     /// The table for linear sRGB reflectances under D65, built on first use (0.2–0.3 s
-    /// on one core at [`SRGB_TABLE_RES`], measured on a loaded machine) and shared.
+    /// of solves at [`SRGB_TABLE_RES`], measured on a loaded machine, on three threads)
+    /// and shared.
     pub fn srgb() -> &'static RgbToSpectrumTable {
         static TABLE: OnceLock<RgbToSpectrumTable> = OnceLock::new();
         TABLE.get_or_init(|| RgbToSpectrumTable::build(SRGB_TABLE_RES))
@@ -345,54 +401,17 @@ impl RgbToSpectrumTable {
             .map(|i| smoothstep(smoothstep(i as f64 / (res - 1) as f64)))
             .collect();
         let q = quadrature();
-        let mut coeffs = vec![[0.0; 3]; 3 * res * res * res];
         let start = res / 5;
-        for c in 0..3 {
-            let mut column_start: Option<[f64; 3]> = None;
-            for yi in 0..res {
-                let mut row_start = column_start;
-                for xi in 0..res {
-                    let x = xi as f64 / (res - 1) as f64;
-                    let y = yi as f64 / (res - 1) as f64;
-                    let rgb_at = |z: f64| {
-                        let mut rgb = [0.0; 3];
-                        rgb[c] = z;
-                        rgb[(c + 1) % 3] = x * z;
-                        rgb[(c + 2) % 3] = y * z;
-                        rgb
-                    };
-                    let solve = |guess: Option<[f64; 3]>, rgb: [f64; 3]| {
-                        if let Some(g) = guess {
-                            let (sol, err) = q.gauss_newton(g, rgb, 20, TABLE_TOLERANCE);
-                            if err < 1e-3 {
-                                return sol;
-                            }
-                        }
-                        RgbSigmoid::fit(rgb).to_normalized()
-                    };
-                    let idx = |zi: usize| ((c * res + zi) * res + yi) * res + xi;
-                    let first = solve(row_start, rgb_at(z_nodes[start]));
-                    if xi == 0 {
-                        column_start = Some(first);
-                    }
-                    row_start = Some(first);
-                    coeffs[idx(start)] = first;
-                    let mut guess = first;
-                    for zi in start + 1..res {
-                        guess = solve(Some(guess), rgb_at(z_nodes[zi]));
-                        coeffs[idx(zi)] = guess;
-                    }
-                    guess = first;
-                    for zi in (1..start).rev() {
-                        guess = solve(Some(guess), rgb_at(z_nodes[zi]));
-                        coeffs[idx(zi)] = guess;
-                    }
-                    // z = 0 is black, which no finite sigmoid reaches: reuse the next node's
-                    // (nearly black) solution.
-                    coeffs[idx(0)] = coeffs[idx(1)];
-                }
+        let plane = res * res * res;
+        let mut coeffs = vec![[0.0; 3]; 3 * plane];
+        // The three planes (which component is largest) are independent: one thread each.
+        // Each plane's solves run in a fixed order, so the table is the same every time.
+        std::thread::scope(|scope| {
+            for (c, part) in coeffs.chunks_mut(plane).enumerate() {
+                let (q, z_nodes) = (&q, &z_nodes);
+                scope.spawn(move || build_plane(q, z_nodes, res, start, c, part));
             }
-        }
+        });
         for v in &mut coeffs {
             let s = RgbSigmoid::from_normalized(*v);
             *v = [s.c0, s.c1, s.c2];
