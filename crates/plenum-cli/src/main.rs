@@ -190,7 +190,9 @@ impl std::str::FromStr for LightSamplerArg {
         match s {
             "power" => Ok(LightSamplerArg(LightSamplerKind::Power)),
             "uniform" => Ok(LightSamplerArg(LightSamplerKind::Uniform)),
-            _ => Err(format!("unknown light sampler `{s}`: expected power or uniform")),
+            _ => Err(format!(
+                "unknown light sampler `{s}`: expected power or uniform"
+            )),
         }
     }
 }

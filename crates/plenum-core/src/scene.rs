@@ -347,10 +347,20 @@ impl Scene {
         self.material_of(it.primitive).coefficients(&it.texture)
     }
 
+    /// Whether material `id` scatters only on its normals' side.
+    pub fn is_one_sided(&self, id: MaterialId) -> bool {
+        self.one_sided[id as usize]
+    }
+
     /// The area light whose surface the primitive is.
     #[inline]
     pub fn light_of(&self, primitive: u32) -> Option<u32> {
         self.primitive_lights[primitive as usize]
+    }
+
+    /// Light `light`'s emission as a spectrum (with its RGB value).
+    pub fn light_emission(&self, light: u32) -> &SpectrumValue {
+        &self.light_spectra[light as usize]
     }
 
     /// Light `light`'s radiance (or intensity) at the sample's wavelengths.

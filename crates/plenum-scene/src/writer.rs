@@ -39,6 +39,25 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
     if let Some(r) = defaults.filter_radius {
         let _ = writeln!(w, "filter_radius = {r:?}");
     }
+    if let Some(k) = defaults.integrator {
+        let _ = writeln!(w, "integrator = \"{}\"", k.name());
+    }
+    if let Some(c) = defaults.color {
+        let mode = match c {
+            plenum_core::integrator::ColorMode::Spectral => "spectral",
+            plenum_core::integrator::ColorMode::Rgb => "rgb",
+        };
+        let _ = writeln!(w, "color = \"{mode}\"");
+    }
+    let sampler = match defaults.light_sampler {
+        plenum_core::light_sampler::LightSamplerKind::Power => "power",
+        plenum_core::light_sampler::LightSamplerKind::Uniform => "uniform",
+    };
+    let _ = writeln!(
+        w,
+        "rr_depth = {}\nlight_sampler = \"{sampler}\"",
+        defaults.rr_depth
+    );
     let _ = writeln!(w);
     let c = &scene.camera;
     let _ = writeln!(
@@ -71,12 +90,15 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
         }
     }
     let keys = unique_keys(&scene.material_names, "material");
-    for (key, m) in keys.iter().zip(&scene.materials) {
+    for (i, (key, m)) in keys.iter().zip(&scene.materials).enumerate() {
         let _ = writeln!(w, "[materials.{}]", quote(key));
         let m = match m {
             Material::Phong(m) => m,
             other => {
                 let _ = writeln!(w, "{}", physical_material(other, &keys));
+                if scene.is_one_sided(i as u32) {
+                    let _ = writeln!(w, "two_sided = false\n");
+                }
                 continue;
             }
         };
@@ -171,7 +193,11 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                     ),
                     Emitter::Triangles { .. } => Ok(()),
                 };
-                let _ = writeln!(w, "color = {}\nsamples = {samples}\n", color(*radiance));
+                let _ = writeln!(
+                    w,
+                    "{}\nsamples = {samples}\n",
+                    emission(scene, i, *radiance, "color")
+                );
             }
             Light::Environment { map, .. } => {
                 let layout = match map.map.layout() {
@@ -187,7 +213,11 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                 );
             }
             Light::Infinite { radiance } => {
-                let _ = writeln!(w, "type = \"infinite\"\ncolor = {}\n", color(*radiance));
+                let _ = writeln!(
+                    w,
+                    "type = \"infinite\"\n{}\n",
+                    emission(scene, i, *radiance, "color")
+                );
             }
             Light::Point {
                 position,
@@ -196,9 +226,9 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
             } => {
                 let _ = writeln!(
                     w,
-                    "type = \"point\"\nposition = {}\ncolor = {}\nattenuation = {}\n",
+                    "type = \"point\"\nposition = {}\n{}\nattenuation = {}\n",
                     vec(*position),
-                    color(*intensity),
+                    emission(scene, i, *intensity, "color"),
                     atten(attenuation)
                 );
             }
@@ -208,9 +238,9 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
             } => {
                 let _ = writeln!(
                     w,
-                    "type = \"directional\"\ndirection = {}\ncolor = {}\n",
+                    "type = \"directional\"\ndirection = {}\n{}\n",
                     vec(*direction),
-                    color(*intensity)
+                    emission(scene, i, *intensity, "color")
                 );
             }
             Light::Spot {
@@ -223,12 +253,12 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
             } => {
                 let _ = writeln!(
                     w,
-                    "type = \"spot\"\nposition = {}\ndirection = {}\ninner_angle = {:?}\nouter_angle = {:?}\ncolor = {}\nattenuation = {}\n",
+                    "type = \"spot\"\nposition = {}\ndirection = {}\ninner_angle = {:?}\nouter_angle = {:?}\n{}\nattenuation = {}\n",
                     vec(*position),
                     vec(*direction),
                     cos_inner.clamp(-1.0, 1.0).acos().to_degrees(),
                     cos_outer.clamp(-1.0, 1.0).acos().to_degrees(),
-                    color(*intensity),
+                    emission(scene, i, *intensity, "color"),
                     atten(attenuation)
                 );
             }
@@ -254,9 +284,9 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                 };
                 writeln!(
                     w,
-                    "[[objects]]\nname = {}{material}\nemission = {}\ntwo_sided = {two_sided}\nlight_samples = {samples}",
+                    "[[objects]]\nname = {}{material}\n{}\ntwo_sided = {two_sided}\nlight_samples = {samples}",
                     quote(name),
-                    color(*radiance)
+                    emission(scene, i, *radiance, "emission")
                 )
             }
             Some(_) => continue,
@@ -410,22 +440,52 @@ fn spectral(t: &SpectralTexture) -> String {
     }
 }
 
-/// A spectrum: a constant as a number, an uplifted RGB value as its colour, anything else
-/// tabulated every 5 nm over 360–830 nm (names are not kept).
+/// A spectrum: a constant as a number, an uplifted RGB value as its colour, a dispersion
+/// formula by its coefficients, a table by its own points, a blackbody tabulated every
+/// nanometre over 360–830 nm (names are not kept).
 fn spectrum(s: &Spectrum) -> String {
     if let Some(rgb) = plenum_core::material::source_rgb(s) {
         return color(Color::new(rgb[0], rgb[1], rgb[2]));
     }
-    if s.is_constant() {
-        return format!("{:?}", s.eval(550.0));
+    let list = |v: &[f64]| {
+        let items: Vec<String> = v.iter().map(|x| format!("{x:?}")).collect();
+        format!("[{}]", items.join(", "))
+    };
+    match s {
+        Spectrum::Constant(c) => return format!("{c:?}"),
+        Spectrum::Sellmeier { b, c } => {
+            return format!("{{ sellmeier = [{}, {}] }}", list(b), list(c))
+        }
+        Spectrum::Sellmeier4 { b, c } => {
+            return format!("{{ sellmeier = [{}, {}] }}", list(b), list(c))
+        }
+        Spectrum::Cauchy { a, b } => return format!("{{ cauchy = [{a:?}, {b:?}] }}"),
+        Spectrum::CiddorAir => return "\"air\"".to_string(),
+        _ => {}
     }
-    let pairs: Vec<String> = (0..=94)
-        .map(|i| {
-            let l = 360.0 + 5.0 * i as f64;
-            format!("[{l:?}, {:?}]", s.eval(l))
-        })
-        .collect();
+    let pairs: Vec<String> = match s {
+        Spectrum::PiecewiseLinear(p) => p
+            .wavelengths()
+            .iter()
+            .zip(p.values())
+            .map(|(l, v)| format!("[{l:?}, {v:?}]"))
+            .collect(),
+        _ => (360..=830)
+            .map(|l| format!("[{:?}, {:?}]", l as f64, s.eval(l as f64)))
+            .collect(),
+    };
     format!("{{ spectrum = [{}] }}", pairs.join(", "))
+}
+
+/// A light's `color`, or its `spectrum` when it was given one.
+fn emission(scene: &Scene, light: usize, rgb: Color, key: &str) -> String {
+    let s = scene.light_emission(light as u32).spectrum();
+    if plenum_core::material::source_rgb(s).is_some() {
+        format!("{key} = {}", color(rgb))
+    } else {
+        let key = if key == "color" { "spectrum" } else { key };
+        format!("{key} = {}", spectrum(s))
+    }
 }
 
 fn vec(v: Vec3) -> String {

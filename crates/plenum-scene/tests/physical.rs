@@ -502,5 +502,8 @@ amount = 0.5
     );
     let l = scene(&one_sided);
     let m = mean(&draw(&l, &path_settings(&l, 16, ColorMode::Rgb, 4)));
-    assert!(m.iter().all(|v| (v - 0.5).abs() <= 1e-6), "one-sided: {m:?}");
+    assert!(
+        m.iter().all(|v| (v - 0.5).abs() <= 1e-6),
+        "one-sided: {m:?}"
+    );
 }

@@ -42,7 +42,8 @@ impl<'s> Reader<'s> {
         let rough_keys = ["roughness", "remap_roughness"];
         let src = self.src;
         let table = |keys: &[&'static str]| {
-            let all: Vec<&'static str> = ["type", "two_sided"].iter().chain(keys).copied().collect();
+            let all: Vec<&'static str> =
+                ["type", "two_sided"].iter().chain(keys).copied().collect();
             src.table(v, &what, &all)
         };
         Ok(Some(match kind {
@@ -318,8 +319,10 @@ impl<'s> Reader<'s> {
     }
 
     /// A spectrum: a named one (`"metal-Au-eta"`, `"stdillum-D65"`, `"water"`), a blackbody
-    /// (`{ blackbody = 6500 }`, kelvin, normalised to peak 1), or a piecewise-linear list
-    /// (`{ spectrum = [[400, 0.2], [700, 0.9]] }`, nm and value).
+    /// (`{ blackbody = 6500 }`, kelvin, normalised to peak 1), a piecewise-linear list
+    /// (`{ spectrum = [[400, 0.2], [700, 0.9]] }`, nm and value), or an index by a
+    /// dispersion formula, λ in µm: `{ sellmeier = [[B₁, B₂, B₃], [C₁, C₂, C₃]] }` (three or
+    /// four terms) or `{ cauchy = [A, B] }` (n = A + B/λ²).
     pub(super) fn spectrum(&self, v: &Value<'s>) -> Result<Spectrum> {
         match v.get_ref() {
             DeValue::String(_) => {
@@ -335,12 +338,44 @@ impl<'s> Reader<'s> {
                 })
             }
             DeValue::Table(_) => {
-                let f = self
-                    .src
-                    .table(v, "a spectrum", &["blackbody", "spectrum"])?;
+                let f = self.src.table(
+                    v,
+                    "a spectrum",
+                    &["blackbody", "spectrum", "sellmeier", "cauchy"],
+                )?;
                 if f.get("blackbody").is_some() {
                     let t = f.positive("blackbody", None)?;
                     return Ok(Spectrum::blackbody(t, 1.0));
+                }
+                if let Some(c) = f.get("cauchy") {
+                    let [a, b] = self.src.numbers::<2>(c, "Cauchy's [A, B in µm²]")?;
+                    return Ok(Spectrum::Cauchy { a, b });
+                }
+                if let Some(list) = f.get("sellmeier") {
+                    let what = "Sellmeier's [[B₁, …], [C₁, … in µm²]], three or four terms";
+                    let rows = self.src.array(list, what)?;
+                    if rows.len() != 2 {
+                        return Err(self.src.error(list.span(), format!("expected {what}")));
+                    }
+                    let terms = |r: &Value<'s>| -> Result<Vec<f64>> {
+                        self.src
+                            .array(r, what)?
+                            .iter()
+                            .map(|x| self.src.number(x))
+                            .collect()
+                    };
+                    let (b, c) = (terms(&rows[0])?, terms(&rows[1])?);
+                    return match (b.len(), c.len()) {
+                        (3, 3) => Ok(Spectrum::Sellmeier {
+                            b: [b[0], b[1], b[2]],
+                            c: [c[0], c[1], c[2]],
+                        }),
+                        (4, 4) => Ok(Spectrum::Sellmeier4 {
+                            b: [b[0], b[1], b[2], b[3]],
+                            c: [c[0], c[1], c[2], c[3]],
+                        }),
+                        _ => Err(self.src.error(list.span(), format!("expected {what}"))),
+                    };
                 }
                 let list = f.required("spectrum")?;
                 let items = self.src.array(list, "[wavelength in nm, value] pairs")?;
