@@ -396,6 +396,20 @@ impl Scene {
         }
     }
 
+    /// The emission k_e of a Phong material at a hit on a primitive that is not a light's
+    /// surface, at the sample's wavelengths; `None` where there is none.
+    pub fn phong_emission(
+        &self,
+        it: &Interaction,
+        wl: &SampledWavelengths,
+    ) -> Option<SampledSpectrum> {
+        let m = self.material_of(it.primitive).phong()?;
+        if m.emissive.is_black() {
+            return None;
+        }
+        Some(self.rgb_radiance(m.emissive.evaluate(&it.texture), wl))
+    }
+
     /// The background's radiance at the sample's wavelengths.
     #[inline]
     pub fn background_spectrum(&self, wl: &SampledWavelengths) -> SampledSpectrum {

@@ -507,3 +507,33 @@ amount = 0.5
         "one-sided: {m:?}"
     );
 }
+
+/// A Phong material's k_e is radiance under the path tracer: a black Phong wall of
+/// k_e = (0.3, 0.6, 0.9) seen head-on shows exactly that in RGB, and within 1 % spectrally.
+#[test]
+fn phong_emission_is_seen_by_the_path_tracer() {
+    let l = scene(
+        r#"
+[camera]
+position = [0, 0, 3]
+look_at = [0, 0, 0]
+fov = 20
+resolution = [8, 8]
+
+[materials.glow]
+emissive = [0.3, 0.6, 0.9]
+diffuse = 0
+
+[[objects]]
+type = "polygon"
+material = "glow"
+vertices = [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]
+"#,
+    );
+    for (color, tolerance) in [(ColorMode::Rgb, 1e-6), (ColorMode::Spectral, 0.01)] {
+        let m = mean(&draw(&l, &path_settings(&l, 64, color, 2)));
+        for (got, want) in m.iter().zip([0.3, 0.6, 0.9]) {
+            assert!((got / want - 1.0).abs() <= tolerance, "{color:?}: {m:?}");
+        }
+    }
+}

@@ -8,6 +8,18 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
+/// Whether ../shared/data is beside the repository: its tests have nothing to read without
+/// it, and say so.
+fn shared_data_present() -> bool {
+    let present = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data")
+        .is_dir();
+    if !present {
+        eprintln!("../shared/data is not here: this test has no files to read");
+    }
+    present
+}
+
 fn ray_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
@@ -53,6 +65,9 @@ fn primitives_written(text: &str) -> usize {
 
 #[test]
 fn every_course_file_loads_and_renders() {
+    if !shared_data_present() {
+        return;
+    }
     let mut files = Vec::new();
     ray_files(
         &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/ray"),

@@ -144,6 +144,9 @@ impl<'a> PathTracer<'a> {
             if let Some(light) = scene.light_of(prim) {
                 let le = self.emitted(light, &it, wo, wl, specular_bounce, pdf_bsdf, previous);
                 l += beta * le;
+            } else if let Some(ke) = scene.phong_emission(&it, wl) {
+                // A Phong surface's k_e: seen, but no light to sample.
+                l += beta * ke;
             }
 
             let Some(bsdf) = scene.bsdf(&it, wo, wl) else {
