@@ -123,7 +123,8 @@ impl<'a> PathTracer<'a> {
                 l += beta * le;
                 record(&mut tree, node, |n| {
                     n.stops.push(Stop::Miss);
-                    n.color = Color::from((beta * le).0);
+                    let [r, g, b] = (beta * le).to_linear_srgb(wl);
+                    n.color = Color::new(r, g, b);
                 });
                 break;
             };
@@ -141,6 +142,7 @@ impl<'a> PathTracer<'a> {
 
             // Light the path finds on its own, weighed against light sampling's chance of
             // having found it.
+            let before = l;
             if let Some(light) = scene.light_of(prim) {
                 let le = self.emitted(light, &it, wo, wl, specular_bounce, pdf_bsdf, previous);
                 l += beta * le;
@@ -148,9 +150,17 @@ impl<'a> PathTracer<'a> {
                 // A Phong surface's k_e: seen, but no light to sample.
                 l += beta * ke;
             }
+            // The ray tree shows what each vertex adds to the pixel, in linear sRGB.
+            let added = |l: SampledSpectrum, wl: &SampledWavelengths| {
+                let [r, g, b] = (l - before).to_linear_srgb(wl);
+                Color::new(r, g, b)
+            };
 
             let Some(bsdf) = scene.bsdf(&it, wo, wl) else {
-                record(&mut tree, node, |n| n.stops.push(Stop::Opaque));
+                record(&mut tree, node, |n| {
+                    n.stops.push(Stop::Opaque);
+                    n.color = added(l, wl);
+                });
                 break;
             };
             let flags = bsdf.flags();
@@ -158,6 +168,7 @@ impl<'a> PathTracer<'a> {
                 let ld = self.sample_light(&it, wo, &bsdf, wl, stream, counts, &ray);
                 l += beta * ld;
             }
+            record(&mut tree, node, |n| n.color = added(l, wl));
             if depth >= self.max_depth {
                 record(&mut tree, node, |n| n.stops.push(Stop::Depth));
                 break;
