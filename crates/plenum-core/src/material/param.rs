@@ -9,7 +9,9 @@
 use crate::color::Color;
 use crate::texture::{Texture, TextureCoords};
 use plenum_spectrum::uplift::d65_normalized;
-use plenum_spectrum::{RgbToSpectrumTable, SampledSpectrum, SampledWavelengths, Spectrum};
+use plenum_spectrum::{
+    RgbSigmoid, RgbToSpectrumTable, SampledSpectrum, SampledWavelengths, Spectrum,
+};
 use std::sync::OnceLock;
 
 /// How an RGB value becomes a spectrum.
@@ -23,13 +25,39 @@ pub enum SpectrumKind {
     Illuminant,
 }
 
-/// The spectrum of an RGB value of that kind.
+/// The spectrum of an RGB value of that kind, fitted exactly (a few dozen microseconds; the
+/// shared table serves textures, looked up per hit).
 pub fn uplift(c: Color, kind: SpectrumKind) -> Spectrum {
-    let rgb = [c.r, c.g, c.b];
+    let rgb = [c.r.max(0.0), c.g.max(0.0), c.b.max(0.0)];
+    let m = rgb[0].max(rgb[1]).max(rgb[2]);
     match kind {
-        SpectrumKind::Albedo => Spectrum::rgb_albedo(rgb),
-        SpectrumKind::Unbounded => Spectrum::rgb_unbounded(rgb),
-        SpectrumKind::Illuminant => Spectrum::rgb_illuminant(rgb),
+        SpectrumKind::Albedo => {
+            let rgb = rgb.map(|v| v.min(1.0));
+            Spectrum::RgbAlbedo {
+                rgb,
+                sigmoid: RgbSigmoid::fit(rgb),
+            }
+        }
+        SpectrumKind::Unbounded | SpectrumKind::Illuminant => {
+            let (scale, sigmoid) = if m > 0.0 {
+                (2.0 * m, RgbSigmoid::fit(rgb.map(|v| v / (2.0 * m))))
+            } else {
+                (0.0, RgbSigmoid::constant(0.0))
+            };
+            if kind == SpectrumKind::Unbounded {
+                Spectrum::RgbUnbounded {
+                    rgb,
+                    scale,
+                    sigmoid,
+                }
+            } else {
+                Spectrum::RgbIlluminant {
+                    rgb,
+                    scale,
+                    sigmoid,
+                }
+            }
+        }
     }
 }
 
