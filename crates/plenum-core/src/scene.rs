@@ -519,7 +519,17 @@ impl Scene {
     }
 
     fn finish_bsdf(&self, b: crate::bxdf::Bxdf, it: &Interaction) -> Option<Bsdf> {
-        let bsdf = Bsdf::new(it.shading_n, None, b);
+        // The shading frame's x, along which anisotropic roughness takes its u value: around
+        // the world's y axis (the scenes' up), or its x axis on surfaces facing up or down.
+        // It turns continuously with the normal, so a brushed surface shows no seam.
+        let n = it.shading_n;
+        let around_y = Vec3::Y.cross(n);
+        let hint = if around_y.length_squared() > 1e-12 {
+            around_y
+        } else {
+            Vec3::X.cross(n)
+        };
+        let bsdf = Bsdf::new(n, Some(hint), b);
         (!bsdf.flags().is_empty()).then_some(bsdf)
     }
 
