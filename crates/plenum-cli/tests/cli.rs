@@ -239,6 +239,16 @@ fn bad_scenes_give_located_errors() {
             "3:1",
             "unknown field `roughness`",
         ),
+        (
+            "[materials.m]\ntype = \"dielectric\"\neta = { sellmeier = [[1, 0, 0], [0.3, 0, 0]] }\n",
+            "3:7",
+            "expected an index η > 0 over 360–830 nm",
+        ),
+        (
+            "[materials.m]\ntype = \"conductor\"\neta = 1.5\nk = { spectrum = [[300, -1], [900, 2]] }\n",
+            "4:5",
+            "expected k ≥ 0",
+        ),
         ("[render]\nintegrator = \"photon\"\n", "2:14", "unknown integrator"),
         ("[render]\ncolor = \"hsv\"\n", "2:9", "unknown colour mode"),
         (

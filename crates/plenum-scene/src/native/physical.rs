@@ -90,11 +90,11 @@ impl<'s> Reader<'s> {
                         (None, None) => self.metal("Cu"),
                         (eta, k) => ConductorSpec::EtaK {
                             eta: match eta {
-                                Some(e) => self.spectral(e, SpectrumKind::Unbounded)?,
+                                Some(e) => self.optical_constant(e, "η")?,
                                 None => self.metal_part("Cu", "eta"),
                             },
                             k: match k {
-                                Some(k) => self.spectral(k, SpectrumKind::Unbounded)?,
+                                Some(k) => self.optical_constant(k, "k")?,
                                 None => self.metal_part("Cu", "k"),
                             },
                         },
@@ -256,7 +256,25 @@ impl<'s> Reader<'s> {
             }
             _ => self.spectrum(v)?,
         };
+        self.positive_over_visible(v, &s, "an index η")?;
         Ok(SpectrumValue::new(s, SpectrumKind::Unbounded))
+    }
+
+    /// Checks that `s` is finite and positive at every 5 nm of 360–830 nm (an index of
+    /// refraction with a pole in the visible, or a negative table, is refused where it is
+    /// written).
+    fn positive_over_visible(&self, v: &Value<'s>, s: &Spectrum, what: &str) -> Result<()> {
+        for i in 0..=94 {
+            let l = 360.0 + 5.0 * i as f64;
+            let x = s.eval(l);
+            if !(x.is_finite() && x > 0.0) {
+                return Err(self.src.error(
+                    v.span(),
+                    format!("expected {what} > 0 over 360–830 nm, found {x} at {l} nm"),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// `roughness` (one number, [u, v] for anisotropy, or a texture) with
@@ -284,6 +302,30 @@ impl<'s> Reader<'s> {
             }
         };
         Ok(Roughness { u, v, remap })
+    }
+
+    /// A conductor's η or k: a colour, texture or spectrum; a spectrum must be positive over
+    /// the visible range (k may be 0).
+    fn optical_constant(&self, v: &Value<'s>, what: &str) -> Result<SpectralTexture> {
+        let t = self.spectral(v, SpectrumKind::Unbounded)?;
+        if let SpectralTexture::Constant(c) = &t {
+            if what == "k" {
+                let s = c.spectrum();
+                for i in 0..=94 {
+                    let l = 360.0 + 5.0 * i as f64;
+                    let x = s.eval(l);
+                    if !(x.is_finite() && x >= 0.0) {
+                        return Err(self.src.error(
+                            v.span(),
+                            format!("expected k ≥ 0 over 360–830 nm, found {x} at {l} nm"),
+                        ));
+                    }
+                }
+            } else {
+                self.positive_over_visible(v, c.spectrum(), "η")?;
+            }
+        }
+        Ok(t)
     }
 
     /// A parameter that may be an RGB colour or texture (uplifted as `kind`) or a spectrum.
