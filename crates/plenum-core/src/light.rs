@@ -670,6 +670,44 @@ fn smoothstep(lo: f64, hi: f64, x: f64) -> f64 {
 mod tests {
     use super::*;
 
+    /// A placed shape's emitter covers the shape: a box's twelve triangles have its surface
+    /// area and face outward; a sphere keeps its centre and radius under a uniform scale
+    /// and is refused (left to its triangles' owner) under a non-uniform one.
+    #[test]
+    fn emitters_of_placed_shapes() {
+        use crate::geometry::{Cuboid, Sphere};
+        let cube = Shape::Cuboid(Cuboid::new(
+            Vec3::new(-1.0, -2.0, -3.0),
+            Vec3::new(1.0, 2.0, 3.0),
+        ));
+        let place = Transform::rotate(Vec3::new(1.0, 2.0, 3.0), 40.0)
+            .unwrap()
+            .after(&Transform::translate(Vec3::new(1.0, -2.0, 3.0)));
+        let e = Emitter::of_shape(&cube, &place).unwrap();
+        assert!((e.area() - 2.0 * (2.0 * 4.0 + 2.0 * 6.0 + 4.0 * 6.0)).abs() < 1e-9);
+        let Emitter::Triangles { triangles, .. } = &e else {
+            panic!("a box emits by its triangles")
+        };
+        assert_eq!(triangles.len(), 12);
+        let centre = place.point(Vec3::ZERO);
+        for t in triangles {
+            let n = (t[1] - t[0]).cross(t[2] - t[0]);
+            let c = (t[0] + t[1] + t[2]) * (1.0 / 3.0);
+            assert!(n.dot(c - centre) > 0.0, "a face turned inward");
+        }
+        let ball = Shape::Sphere(Sphere::new(Vec3::new(1.0, 0.0, 0.0), 0.5));
+        let grow = Transform::scale(Vec3::splat(2.0)).unwrap();
+        match Emitter::of_shape(&ball, &grow) {
+            Some(Emitter::Sphere { center, radius }) => {
+                assert!((center - Vec3::new(2.0, 0.0, 0.0)).length() < 1e-12);
+                assert!((radius - 1.0).abs() < 1e-12);
+            }
+            other => panic!("{other:?}"),
+        }
+        let squash = Transform::scale(Vec3::new(1.0, 2.0, 1.0)).unwrap();
+        assert!(Emitter::of_shape(&ball, &squash).is_none());
+    }
+
     #[test]
     fn point_light_falls_off_with_the_inverse_square() {
         let light = Light::Point {
@@ -718,7 +756,8 @@ mod tests {
     /// The solid-angle pdf an area light's samples claim (L_e / intensity with L_e = 1),
     /// checked by chi-square against the pdf computed independently from the geometry, for
     /// each emitter seen from the origin (seed 0x5EED0005, 10⁶ samples; the crate-wide
-    /// significance of chi_square.rs).
+    /// significance of chi_square.rs); and `Emitter::pdf` of each sampled point, which MIS
+    /// uses for points found by BSDF rays, equal to the sample's own pdf (to 10⁻⁹).
     mod chi_square_tests {
         use super::*;
         use crate::sampling::chi_square::SphericalBins;
@@ -727,6 +766,7 @@ mod tests {
         const SEED: u64 = 0x5EED0005;
 
         fn check(shape: Emitter, pdf: impl Fn(Vec3) -> f64, what: &str) {
+            let emitter = shape.clone();
             let light = Light::Area {
                 shape,
                 radiance: Color::WHITE,
@@ -746,6 +786,16 @@ mod tests {
                             (claimed / truth - 1.0).abs() < 1e-6,
                             "{what}: claimed {claimed}, true {truth}"
                         );
+                        // What the path tracer's MIS asks of a point a BSDF ray found, and
+                        // what light sampling hands it, agree.
+                        let (q, n, sampled) = emitter.sample_with_normal(Vec3::ZERO, u).unwrap();
+                        let asked = emitter.pdf(Vec3::ZERO, q, n);
+                        assert!(
+                            (asked / sampled - 1.0).abs() < 1e-9,
+                            "{what}: pdf of the point {asked}, of its sample {sampled}"
+                        );
+                        let ls = light.sample_li(Vec3::ZERO, u).unwrap();
+                        assert!((ls.pdf / sampled - 1.0).abs() < 1e-12 && !ls.delta);
                         inc.wi
                     },
                     &pdf,
