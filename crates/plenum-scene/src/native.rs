@@ -743,7 +743,11 @@ impl<'s> Reader<'s> {
         scale: f64,
     ) -> Result<(Color, Option<plenum_spectrum::Spectrum>)> {
         match v.get_ref() {
-            DeValue::String(_) | DeValue::Table(_) => Ok((Color::BLACK, Some(self.spectrum(v)?))),
+            DeValue::String(_) | DeValue::Table(_) => {
+                let s = self.spectrum(v)?;
+                let [r, g, b] = s.to_rgb_illuminant();
+                Ok((Color::new(r, g, b) * scale, Some(s)))
+            }
             _ => Ok((self.non_negative(v, self.color(v)?)? * scale, None)),
         }
     }
