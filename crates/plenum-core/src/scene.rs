@@ -480,7 +480,10 @@ impl Scene {
         if p.vertex_materials.is_some() {
             let k = self.coefficients(it);
             let phong = Material::Phong(crate::material::PhongMaterial::constant(&k));
-            return self.bsdf_of(&phong, it, wl, solid, 0.5);
+            return match phong.scattering(&it.texture, wl, solid, 0.5) {
+                Scattering::Bxdf(b) => self.finish_bsdf(b, it),
+                Scattering::Other(_) => None,
+            };
         }
         let mut id = p.material;
         if self.one_sided[id as usize] && wo.dot(it.n) < 0.0 {
@@ -502,20 +505,6 @@ impl Scene {
             }
         }
         None
-    }
-
-    fn bsdf_of(
-        &self,
-        m: &Material,
-        it: &Interaction,
-        wl: &mut SampledWavelengths,
-        solid: bool,
-        u: f64,
-    ) -> Option<Bsdf> {
-        match m.scattering(&it.texture, wl, solid, u) {
-            Scattering::Bxdf(b) => self.finish_bsdf(b, it),
-            Scattering::Other(_) => None,
-        }
     }
 
     fn finish_bsdf(&self, b: crate::bxdf::Bxdf, it: &Interaction) -> Option<Bsdf> {
@@ -741,39 +730,6 @@ impl SceneBuilder {
         );
         if let Some(last) = self.light_objects.last_mut() {
             *last = object;
-        }
-    }
-
-    /// Adds a triangle mesh that emits `radiance` from both sides of every triangle: an
-    /// object to see and an area light sampled over its triangles by area.
-    pub fn add_mesh_light(
-        &mut self,
-        name: impl Into<String>,
-        mesh: Arc<TriangleMesh>,
-        to_world: Transform,
-        radiance: Color,
-        samples: u32,
-    ) {
-        let name = name.into();
-        let triangles = mesh
-            .triangles()
-            .map(|(_, t)| t.map(|p| to_world.point(p)))
-            .collect();
-        let material = self.add_material(format!("{name} (emitter)"), Material::emitter(radiance));
-        self.add_object(name.clone(), Shape::Mesh(mesh), to_world, material);
-        if let Some(shape) = Emitter::triangles(triangles) {
-            self.add_light(
-                name,
-                Light::Area {
-                    shape,
-                    radiance,
-                    samples,
-                    two_sided: true,
-                },
-            );
-            if let Some(last) = self.light_objects.last_mut() {
-                *last = Some((self.primitives.len() - 1) as u32);
-            }
         }
     }
 

@@ -952,30 +952,24 @@ impl<'s> Reader<'s> {
             let (radiance, spectrum) = self.emission(e, scale)?;
             let samples = self.light_samples(&f, "light_samples")?;
             let two_sided = f.bool_or("two_sided", true)?;
-            match (&shape, f.get("material")) {
-                // Whitted's emitting mesh: it shows its emission and reflects nothing.
-                (Shape::Mesh(mesh), None) if two_sided => {
-                    self.builder
-                        .add_mesh_light(name, mesh.clone(), to_world, radiance, samples);
-                }
-                (_, given) => {
-                    let material = match given {
-                        Some(_) => material,
-                        None => self.builder.add_material(
-                            format!("{name} (emitter)"),
-                            plenum_core::material::Material::emitter(radiance),
-                        ),
-                    };
-                    let what = f.required("emission")?.span();
-                    if !self.builder.add_emissive_object(
-                        name, shape, to_world, material, radiance, two_sided, samples,
-                    ) {
-                        return Err(self.src.error(
-                            what,
-                            format!("a {kind} cannot be an area light: use a mesh, sphere, disk, polygon, box or polyhedron"),
-                        ));
-                    }
-                }
+            // Without a material of its own the object only shows its light.
+            let material = match f.get("material") {
+                Some(_) => material,
+                None => self.builder.add_material(
+                    format!("{name} (emitter)"),
+                    plenum_core::material::Material::emitter(radiance),
+                ),
+            };
+            let what = f.required("emission")?.span();
+            let added = self.builder.add_emissive_object(
+                name, shape, to_world, material, radiance, two_sided, samples,
+            );
+            // A mesh without area is placed, dark, as before; other shapes cannot be sampled.
+            if !added && kind != "mesh" {
+                return Err(self.src.error(
+                    what,
+                    format!("a {kind} cannot be an area light: use a mesh, sphere, disk, polygon, box or polyhedron"),
+                ));
             }
             if let Some(s) = spectrum {
                 self.builder.set_last_light_spectrum(s, scale);

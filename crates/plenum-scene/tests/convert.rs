@@ -1,23 +1,13 @@
 //! `to_toml` writes a scene that renders exactly as the one it came from, whatever format
 //! that was: the native format itself, NFF and `.ray` (with nested transforms and meshes).
 
+mod common;
+use common::shared_data_present;
 use plenum_core::integrator::IntegratorKind;
 use plenum_core::render::{render, RenderSettings};
 use plenum_scene::{builtin_scene, load_scene, parse_scene, to_toml, LoadedScene};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
-
-/// Whether ../shared/data is beside the repository: its tests have nothing to read without
-/// it, and say so.
-fn shared_data_present() -> bool {
-    let present = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
-        .is_dir();
-    if !present {
-        eprintln!("../shared/data is not here: this test has no files to read");
-    }
-    present
-}
 
 fn shared(rel: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -1,23 +1,13 @@
 //! The shared meshes load with the vertex and triangle counts their SOURCES.md lists, and
 //! render on their own, framed by the default camera.
 
+mod common;
+use common::shared_data_present;
 use plenum_core::geometry::Shape;
 use plenum_core::render::{render, RenderSettings};
 use plenum_scene::{load_scene, LoadedScene};
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
-
-/// Whether ../shared/data is beside the repository: its tests have nothing to read without
-/// it, and say so.
-fn shared_data_present() -> bool {
-    let present = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
-        .is_dir();
-    if !present {
-        eprintln!("../shared/data is not here: this test has no files to read");
-    }
-    present
-}
 
 fn meshes() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/meshes")

@@ -1,24 +1,14 @@
 //! Every NFF file of the Standard Procedural Databases in ../shared/data/nff loads with the
 //! record counts its SOURCES.md lists, and renders a plausible picture.
 
+mod common;
+use common::shared_data_present;
 use plenum_core::geometry::Shape;
 use plenum_core::render::{render, RenderSettings};
 use plenum_core::sampling::PixelSampler;
 use plenum_scene::load_scene;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
-
-/// Whether ../shared/data is beside the repository: its tests have nothing to read without
-/// it, and say so.
-fn shared_data_present() -> bool {
-    let present = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
-        .is_dir();
-    if !present {
-        eprintln!("../shared/data is not here: this test has no files to read");
-    }
-    present
-}
 
 fn shared(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -1,24 +1,14 @@
 //! Every `.ray` file in ../shared/data/ray loads (both dialects), places one object for each
 //! primitive the file writes, and renders a plausible picture.
 
+mod common;
+use common::shared_data_present;
 use plenum_core::render::{render, RenderSettings};
 use plenum_core::sampling::PixelSampler;
 use plenum_scene::load_scene;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
-
-/// Whether ../shared/data is beside the repository: its tests have nothing to read without
-/// it, and say so.
-fn shared_data_present() -> bool {
-    let present = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
-        .is_dir();
-    if !present {
-        eprintln!("../shared/data is not here: this test has no files to read");
-    }
-    present
-}
 
 fn ray_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {
