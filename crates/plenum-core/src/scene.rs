@@ -344,7 +344,26 @@ impl Scene {
             });
             return Coefficients::blend(&parts);
         }
-        self.material_of(it.primitive).coefficients(&it.texture)
+        self.coefficients_of(
+            self.primitives[it.primitive as usize].material,
+            &it.texture,
+            0,
+        )
+    }
+
+    /// Material `id`'s coefficients; a mix blends its two materials' by its amount (a few
+    /// mixes deep; a deeper one gives its first material's).
+    fn coefficients_of(&self, id: MaterialId, at: &TextureCoords, depth: u32) -> Coefficients {
+        match &self.materials[id as usize] {
+            Material::Mix { materials, amount } if depth < 16 => {
+                let a = amount.evaluate(at).clamp(0.0, 1.0);
+                Coefficients::blend(&[
+                    (1.0 - a, self.coefficients_of(materials[0], at, depth + 1)),
+                    (a, self.coefficients_of(materials[1], at, depth + 1)),
+                ])
+            }
+            m => m.coefficients(at),
+        }
     }
 
     /// Whether material `id` scatters only on its normals' side.

@@ -537,3 +537,49 @@ vertices = [[-2, -2, 0], [2, -2, 0], [2, 2, 0], [-2, 2, 0]]
         }
     }
 }
+
+/// Under Whitted a mix is the blend of its materials' coefficients: half of reflectance 0.3
+/// and half of 0.7 renders as reflectance 0.5 does (to 1e-6).
+#[test]
+fn whitted_blends_a_mix() {
+    let lit = |materials: &str| {
+        scene(&format!(
+            r#"
+[camera]
+position = [0, 0, 4]
+look_at = [0, 0, 0]
+resolution = [8, 8]
+{materials}
+[[objects]]
+type = "sphere"
+radius = 1
+material = "m"
+[[lights]]
+type = "point"
+position = [2, 3, 4]
+"#
+        ))
+    };
+    let mix = lit(
+        "[materials.a]\ntype = \"diffuse\"\nreflectance = 0.3\n[materials.b]\ntype = \"diffuse\"\nreflectance = 0.7\n[materials.m]\ntype = \"mix\"\nmaterials = [\"a\", \"b\"]\n",
+    );
+    let half = lit("[materials.m]\ntype = \"diffuse\"\nreflectance = 0.5\n");
+    let whitted = |l: &LoadedScene| {
+        let settings = RenderSettings {
+            width: 8,
+            height: 8,
+            ..Default::default()
+        };
+        render(&l.scene, &settings, &AtomicBool::new(false), &|_, _| {})
+            .film
+            .pixels()
+            .to_vec()
+    };
+    let (a, b) = (whitted(&mix), whitted(&half));
+    assert!(b.iter().flatten().any(|&v| v > 0.05), "the image is lit");
+    for (p, q) in a.iter().zip(&b) {
+        for c in 0..3 {
+            assert!((p[c] - q[c]).abs() < 1e-6, "{p:?} vs {q:?}");
+        }
+    }
+}

@@ -142,8 +142,8 @@ impl Material {
     /// Whitted's coefficients at a point, for the `whitted` integrator. The physically based
     /// materials give their nearest Phong reading (docs/materials.md): diffuse as k_d, a
     /// conductor as a mirror of its normal-incidence reflectance, glass with Fresnel
-    /// weighting, roughness as a Phong gloss exponent 2/α² − 2. A mix gives its first
-    /// material's (the scene blends them, [`crate::scene::Scene::coefficients`]).
+    /// weighting, roughness as a Phong gloss exponent 2/α² − 2. A mix gives none of its own:
+    /// the scene blends its two materials' ([`crate::scene::Scene::coefficients`]).
     pub fn coefficients(&self, at: &TextureCoords) -> Coefficients {
         let black = Color::BLACK;
         let base = Coefficients {
