@@ -78,3 +78,11 @@ impl Div<f64> for Color {
         self * (1.0 / s)
     }
 }
+
+impl From<[f64; 4]> for Color {
+    /// The first three lanes of a sampled spectrum, as seen in RGB mode (the ray tree's
+    /// weights; spectral lanes are shown as they are).
+    fn from(v: [f64; 4]) -> Color {
+        Color::new(v[0], v[1], v[2])
+    }
+}
