@@ -98,9 +98,11 @@ struct ViewArgs {
     /// only).
     #[arg(long)]
     max_depth: Option<u32>,
-    /// The rendering method: whitted (recursive ray tracing with the Phong model) or path
-    /// (path tracing). Default: the scene file's choice, else path for a scene of physically
-    /// based materials only and whitted otherwise.
+    /// The rendering method, the lecture's ladder: local (the Phong model from every light,
+    /// no shadows), appel (local plus shadow rays), whitted (recursive ray tracing), path (path
+    /// tracing), light (light tracing), photon (photon mapping), sppm (stochastic progressive
+    /// photon mapping) or bdpt (bidirectional path tracing). Default: the scene file's choice,
+    /// else path for a scene of physically based materials only and whitted otherwise.
     #[arg(long)]
     integrator: Option<IntegratorArg>,
     /// How light is represented: spectral (4 sampled wavelengths per camera sample; the
@@ -394,12 +396,12 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
     let color = view.color.map(|a| a.0).or(d.color).unwrap_or_default();
     let light_sampler = view.light_sampler.map_or(d.light_sampler, |a| a.0);
     loaded.scene.set_light_sampler(light_sampler);
-    if method != IntegratorKind::Whitted && color == ColorMode::Rgb {
+    if !method.is_classic() && color == ColorMode::Rgb {
         if let Some(what) = loaded.scene.needs_wavelengths() {
             eprintln!("warning: {what} needs wavelengths: in RGB mode it is rendered at 589.3 nm (use --color spectral)");
         }
     }
-    Ok(RenderSettings {
+    let settings = RenderSettings {
         width,
         height,
         sampler,
@@ -414,7 +416,33 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
         },
         seed: view.seed,
         corners: view.nff_corners,
-    })
+    };
+    if let Err(e) = settings.check() {
+        eprintln!("error: {e}");
+        return Err(ExitCode::from(2));
+    }
+    Ok(settings)
+}
+
+/// Rays by kind, the kinds the method traced (camera, shadow, reflection and refraction
+/// always; light, connection and photon rays where there were any).
+fn ray_summary(c: &plenum_core::integrator::RayCounts) -> String {
+    let mut parts = vec![
+        format!("{} camera", c.camera),
+        format!("{} shadow", c.shadow),
+        format!("{} reflection", c.reflection),
+        format!("{} refraction", c.refraction),
+    ];
+    for (n, kind) in [
+        (c.light, "light"),
+        (c.connection, "connection"),
+        (c.photon, "photon"),
+    ] {
+        if n > 0 {
+            parts.push(format!("{n} {kind}"));
+        }
+    }
+    parts.join(", ")
 }
 
 fn convert(args: ConvertArgs) -> ExitCode {
@@ -509,7 +537,7 @@ fn run_render(args: RenderArgs) -> ExitCode {
     if !args.quiet {
         let c = &output.counts;
         eprintln!(
-            "loaded in {:.3} s; {}×{}, {}, {:.3} s, rays: {} camera, {} shadow, {} reflection, {} refraction; {:.2} Mrays/s → {}",
+            "loaded in {:.3} s; {}×{}, {}, {:.3} s, {} ({}), rays: {}; {:.2} Mrays/s → {}",
             load_seconds,
             film.width,
             film.height,
@@ -521,10 +549,15 @@ fn run_render(args: RenderArgs) -> ExitCode {
                 ),
             },
             elapsed,
-            c.camera,
-            c.shadow,
-            c.reflection,
-            c.refraction,
+            settings.integrator.kind.name(),
+            match (
+                settings.integrator.kind.is_classic(),
+                settings.integrator.color
+            ) {
+                (false, ColorMode::Spectral) => "spectral",
+                _ => "rgb",
+            },
+            ray_summary(c),
             c.total() as f64 / elapsed / 1e6,
             args.output.display()
         );

@@ -4,10 +4,15 @@
 //! of a pixel's own estimate (`add_sample`: the pixel is Σ w·L / Σ w), and splats, which
 //! integrators that start paths on the lights (light tracing, bidirectional path tracing)
 //! add to whatever pixel a path reaches (`add_splat`: summed, then scaled once by
-//! `resolve`, by 1/spp for such an integrator). Splats are added in a fixed order by the
-//! caller, so the image stays the same for any thread count.
+//! `resolve`, by 1/spp for such an integrator).
+//!
+//! Light paths run on every thread at once, so their splats go first into a
+//! [`SplatBuffer`], which sums in fixed point: integer addition does not depend on its order,
+//! so the image is the same for any thread count, and the sums of renders split by sample
+//! range add up to the sums of the whole.
 
 use crate::color::Color;
+use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
 
 #[derive(Clone, Debug)]
 pub struct Film {
@@ -78,6 +83,15 @@ impl Film {
         }
     }
 
+    /// Adds the splats summed in `buffer`.
+    pub fn add_splats(&mut self, buffer: &SplatBuffer) {
+        for (s, b) in self.splats.iter_mut().zip(&buffer.sums) {
+            for c in 0..3 {
+                s[c] += b[c].load(Ordering::Relaxed) as f64 * SplatBuffer::UNIT;
+            }
+        }
+    }
+
     /// The resolved pixel (x, y).
     pub fn get(&self, x: u32, y: u32) -> Color {
         let p = self.pixels[self.index(x, y)];
@@ -87,6 +101,60 @@ impl Film {
     /// The resolved image, row by row.
     pub fn pixels(&self) -> &[[f32; 3]] {
         &self.pixels
+    }
+}
+
+/// Splats from many threads at once, per pixel and channel, in fixed point: 32 bits of
+/// fraction and 31 of integer part. Each splat is scaled by the render's splat factor
+/// (1/spp) on the way in, so the sums are pixel values.
+pub struct SplatBuffer {
+    width: u32,
+    height: u32,
+    scale: f64,
+    sums: Vec<[AtomicI64; 3]>,
+    /// Splats too large for the fixed point, clamped.
+    clamped: AtomicU64,
+}
+
+impl SplatBuffer {
+    const UNIT: f64 = 1.0 / 4_294_967_296.0;
+    /// The largest single splat, in units: 2²⁴ in value, far above any pixel.
+    const MAX: f64 = (1u64 << 56) as f64;
+
+    pub fn new(width: u32, height: u32, scale: f64) -> SplatBuffer {
+        let n = width as usize * height as usize;
+        SplatBuffer {
+            width,
+            height,
+            scale,
+            sums: (0..n).map(|_| Default::default()).collect(),
+            clamped: AtomicU64::new(0),
+        }
+    }
+
+    /// Adds `c` × the buffer's scale to the pixel that raster point `p` falls in (a box
+    /// filter); points off the film and values that are not finite are dropped.
+    pub fn add(&self, p: [f64; 2], c: Color) {
+        let [px, py] = p;
+        if !(px >= 0.0 && py >= 0.0 && px < self.width as f64 && py < self.height as f64) {
+            return;
+        }
+        let i = py as usize * self.width as usize + px as usize;
+        for (sum, v) in self.sums[i].iter().zip([c.r, c.g, c.b]) {
+            let units = (v * self.scale / Self::UNIT).round();
+            if !units.is_finite() || units == 0.0 {
+                continue;
+            }
+            if units.abs() > Self::MAX {
+                self.clamped.fetch_add(1, Ordering::Relaxed);
+            }
+            sum.fetch_add(units.clamp(-Self::MAX, Self::MAX) as i64, Ordering::Relaxed);
+        }
+    }
+
+    /// How many splat values were too large and were clamped.
+    pub fn clamped(&self) -> u64 {
+        self.clamped.load(Ordering::Relaxed)
     }
 }
 
@@ -109,5 +177,34 @@ mod tests {
         assert_eq!(film.get(1, 0), Color::gray(1.5));
         assert_eq!(film.get(0, 1), Color::gray(0.5));
         assert_eq!(film.get(1, 1), Color::BLACK);
+    }
+
+    /// The fixed-point sums do not depend on the order of the splats.
+    #[test]
+    fn splat_sums_ignore_order() {
+        let values: Vec<f64> = (0..1000)
+            .map(|i| ((i * 7919) % 1000) as f64 * 1e-3 + 1e-7)
+            .collect();
+        let forward = SplatBuffer::new(1, 1, 0.5);
+        let backward = SplatBuffer::new(1, 1, 0.5);
+        for &v in &values {
+            forward.add([0.5, 0.5], Color::new(v, 2.0 * v, 1e6 * v));
+        }
+        for &v in values.iter().rev() {
+            backward.add([0.5, 0.5], Color::new(v, 2.0 * v, 1e6 * v));
+        }
+        let (mut a, mut b) = (Film::new(1, 1), Film::new(1, 1));
+        a.add_splats(&forward);
+        b.add_splats(&backward);
+        a.resolve(1.0);
+        b.resolve(1.0);
+        assert_eq!(a.get(0, 0), b.get(0, 0));
+        let sum: f64 = values.iter().sum();
+        assert!(
+            (a.get(0, 0).r - 0.5 * sum).abs() < 1e-4,
+            "the resolved film is f32"
+        );
+        forward.add([0.5, 0.5], Color::gray(1e12));
+        assert_eq!(forward.clamped(), 3);
     }
 }

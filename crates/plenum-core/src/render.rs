@@ -12,7 +12,7 @@
 
 use crate::camera::Camera;
 use crate::color::Color;
-use crate::film::Film;
+use crate::film::{Film, SplatBuffer};
 use crate::integrator::{Integrator, IntegratorConfig, RayCounts, RayTree};
 use crate::sampling::{Filter, PixelSampler, Rng, SampleStream};
 use crate::scene::Scene;
@@ -49,6 +49,28 @@ impl Default for RenderSettings {
             seed: 0,
             corners: false,
         }
+    }
+}
+
+impl RenderSettings {
+    /// Whether the integrator can work with these settings; the reason where it cannot.
+    pub fn check(&self) -> Result<(), String> {
+        let kind = self.integrator.kind;
+        if kind.splats() {
+            let name = kind.name();
+            if self.adaptive.is_some() {
+                return Err(format!("integrator `{name}` adds light to pixels other than the one sampled, so it needs a fixed number of samples per pixel: adaptive sampling is not available with it"));
+            }
+            if self.corners {
+                return Err(format!(
+                    "integrator `{name}` cannot trace the SPD pixel corners (--nff-corners)"
+                ));
+            }
+            if self.filter != Filter::default() {
+                return Err(format!("integrator `{name}` splats light paths onto pixels with the box filter of one pixel; other filters are not available with it"));
+            }
+        }
+        Ok(())
     }
 }
 
@@ -95,7 +117,14 @@ pub fn render(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> RenderOutput {
     let camera = Camera::new(&scene.camera, settings.width, settings.height);
-    let integrator = Integrator::new(scene, &settings.integrator);
+    // Splats are pixel values once divided by the light paths per pixel.
+    let splats = if settings.integrator.kind.splats() {
+        let spp = settings.sampler.samples_per_pixel().max(1);
+        SplatBuffer::new(settings.width, settings.height, 1.0 / spp as f64)
+    } else {
+        SplatBuffer::new(0, 0, 0.0)
+    };
+    let integrator = Integrator::new(scene, &settings.integrator, &camera, &splats);
     // In corner mode the grid rendered is that of the corners, one ray each.
     let extra = u32::from(settings.corners);
     let (w, h) = (settings.width + extra, settings.height + extra);
@@ -170,8 +199,9 @@ pub fn render(
             film.set(x, y, colors[(y * w + x) as usize]);
         }
     }
-    // No integrator here splats yet (light tracing will); resolving keeps the one path.
+    film.add_splats(&splats);
     film.resolve(1.0);
+    counts.invalid += splats.clamped();
     RenderOutput {
         film: if settings.corners {
             average_corners(&film)
@@ -516,7 +546,8 @@ fn corner_stream(seed: u64, x: u32, y: u32) -> SampleStream {
 /// The ray tree of one pixel: every ray of every sample, and the pixel's colour.
 pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> (RayTree, Color) {
     let camera = Camera::new(&scene.camera, settings.width, settings.height);
-    let integrator = Integrator::new(scene, &settings.integrator);
+    let splats = SplatBuffer::new(settings.width, settings.height, 1.0);
+    let integrator = Integrator::new(scene, &settings.integrator, &camera, &splats);
     let mut tree = RayTree::default();
     let mut counts = RayCounts::default();
     let c = render_pixel(

@@ -10,6 +10,12 @@ pub enum RayKind {
     Shadow,
     Reflected,
     Refracted,
+    /// A ray of a light path: leaving a light, or scattered along the path.
+    Light,
+    /// A ray joining a path's vertex to the camera or to another path's vertex.
+    Connection,
+    /// A photon's flight (photon mapping).
+    Photon,
 }
 
 impl RayKind {
@@ -19,6 +25,9 @@ impl RayKind {
             RayKind::Shadow => "shadow",
             RayKind::Reflected => "reflected",
             RayKind::Refracted => "refracted",
+            RayKind::Light => "light",
+            RayKind::Connection => "connection",
+            RayKind::Photon => "photon",
         }
     }
 }

@@ -35,6 +35,8 @@ pub struct WhittedConfig {
     pub max_depth: u32,
     /// Rays whose weight in the pixel (largest RGB component) falls below this are not traced.
     pub min_weight: f64,
+    /// Shadow rays decide S_L; without them every light is seen (local illumination).
+    pub shadows: bool,
 }
 
 impl Default for WhittedConfig {
@@ -42,6 +44,7 @@ impl Default for WhittedConfig {
         WhittedConfig {
             max_depth: 5,
             min_weight: 1.0 / 256.0,
+            shadows: true,
         }
     }
 }
@@ -53,13 +56,25 @@ pub struct RayCounts {
     pub shadow: u64,
     pub reflection: u64,
     pub refraction: u64,
+    /// Rays of light paths: leaving a light and scattered along the path.
+    pub light: u64,
+    /// Connections between a path's vertex and the camera or another path's vertex.
+    pub connection: u64,
+    /// Photon rays (photon mapping's passes).
+    pub photon: u64,
     /// Samples that came out NaN or infinite and were left out of the film.
     pub invalid: u64,
 }
 
 impl RayCounts {
     pub fn total(&self) -> u64 {
-        self.camera + self.shadow + self.reflection + self.refraction
+        self.camera
+            + self.shadow
+            + self.reflection
+            + self.refraction
+            + self.light
+            + self.connection
+            + self.photon
     }
 
     pub fn add(&mut self, o: &RayCounts) {
@@ -67,6 +82,9 @@ impl RayCounts {
         self.shadow += o.shadow;
         self.reflection += o.reflection;
         self.refraction += o.refraction;
+        self.light += o.light;
+        self.connection += o.connection;
+        self.photon += o.photon;
         self.invalid += o.invalid;
     }
 }
@@ -190,7 +208,11 @@ impl<'a> Whitted<'a> {
                 if cos <= 0.0 || n.dot(inc.wi) <= 0.0 {
                     continue;
                 }
-                let s = self.shadow(ray, &it, n, &inc, li, &mut b, node, counts);
+                let s = if self.config.shadows {
+                    self.shadow(ray, &it, n, &inc, li, &mut b, node, counts)
+                } else {
+                    Color::WHITE
+                };
                 if s.is_black() {
                     continue;
                 }

@@ -17,6 +17,9 @@ use crate::sampling::{
 };
 use std::sync::Arc;
 
+mod emission;
+pub use emission::{EmissionPdf, EmissionSample};
+
 /// Distance attenuation f(d) = min(1, 1 / (a + b·d + c·d²)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Attenuation {
@@ -267,30 +270,11 @@ impl Emitter {
         d2 / (cos_light * self.area())
     }
 
-    /// A point of the surface for `p` to aim at, its unit normal, and the pdf of choosing it
-    /// with respect to solid angle at `p` (the area pdf converted by d² / |cos θ_light|);
-    /// `None` if the sample sees the surface edge-on.
-    fn sample_with_normal(&self, p: Vec3, u: [f64; 2]) -> Option<(Vec3, Vec3, f64)> {
-        let (point, normal) = match self {
+    /// A point uniform over the surface by area (density 1 / [`Emitter::area`]) and its unit
+    /// normal: where light paths start.
+    pub fn sample_area(&self, u: [f64; 2]) -> Option<(Vec3, Vec3)> {
+        Some(match self {
             Emitter::Sphere { center, radius } => {
-                let to_center = *center - p;
-                let d2 = to_center.length_squared();
-                let r2 = radius * radius;
-                if d2 > r2 * (1.0 + 1e-9) {
-                    // Outside: sample the cone of directions the sphere fills, uniformly in
-                    // solid angle (the visible cap, without wasted samples on the far side).
-                    let d = d2.sqrt();
-                    let cos_max = ((d2 - r2).max(0.0)).sqrt() / d;
-                    let local = uniform_cone(u, cos_max);
-                    let w = Frame::from_z(to_center / d).to_world(local);
-                    // Nearest intersection of p + s·w with the sphere (s ≥ 0).
-                    let b = w.dot(to_center);
-                    let disc = (r2 - (d2 - b * b)).max(0.0);
-                    let s = b - disc.sqrt();
-                    let q = p + w * s;
-                    let n = (q - *center) / *radius;
-                    return Some((q, n, uniform_cone_pdf(cos_max)));
-                }
                 let n = uniform_sphere(u);
                 (*center + n * *radius, n)
             }
@@ -329,7 +313,34 @@ impl Emitter {
                 let n = (b - a).cross(c - a).normalized();
                 (a * b0 + b * b1 + c * (1.0 - b0 - b1), n)
             }
-        };
+        })
+    }
+
+    /// A point of the surface for `p` to aim at, its unit normal, and the pdf of choosing it
+    /// with respect to solid angle at `p` (the area pdf converted by d² / |cos θ_light|);
+    /// `None` if the sample sees the surface edge-on.
+    fn sample_with_normal(&self, p: Vec3, u: [f64; 2]) -> Option<(Vec3, Vec3, f64)> {
+        if let Emitter::Sphere { center, radius } = self {
+            let to_center = *center - p;
+            let d2 = to_center.length_squared();
+            let r2 = radius * radius;
+            if d2 > r2 * (1.0 + 1e-9) {
+                // Outside: sample the cone of directions the sphere fills, uniformly in
+                // solid angle (the visible cap, without wasted samples on the far side).
+                let d = d2.sqrt();
+                let cos_max = ((d2 - r2).max(0.0)).sqrt() / d;
+                let local = uniform_cone(u, cos_max);
+                let w = Frame::from_z(to_center / d).to_world(local);
+                // Nearest intersection of p + s·w with the sphere (s ≥ 0).
+                let b = w.dot(to_center);
+                let disc = (r2 - (d2 - b * b)).max(0.0);
+                let s = b - disc.sqrt();
+                let q = p + w * s;
+                let n = (q - *center) / *radius;
+                return Some((q, n, uniform_cone_pdf(cos_max)));
+            }
+        }
+        let (point, normal) = self.sample_area(u)?;
         let to = point - p;
         let d2 = to.length_squared();
         let cos_light = normal.dot(to).abs() / d2.sqrt();
