@@ -146,6 +146,11 @@ struct RenderArgs {
     /// No progress bar and no summary.
     #[arg(short, long)]
     quiet: bool,
+    /// Bidirectional path tracing: also write the image of every strategy (s light
+    /// vertices, t camera vertices) into this folder, as `s{s}_t{t}` weighted by MIS and
+    /// `s{s}_t{t}_unweighted`, in the output's format; they sum to the image.
+    #[arg(long)]
+    write_strategies: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -413,6 +418,7 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
             min_weight: d.min_weight,
             rr_depth: view.rr_depth.unwrap_or(d.rr_depth),
             color,
+            strategies: false,
         },
         seed: view.seed,
         corners: view.nff_corners,
@@ -477,10 +483,21 @@ fn run_render(args: RenderArgs) -> ExitCode {
         };
     }
     let load_seconds = load_start.elapsed().as_secs_f64();
-    let settings = match settings(&args.view, &mut loaded) {
+    let mut settings = match settings(&args.view, &mut loaded) {
         Ok(s) => s,
         Err(code) => return code,
     };
+    if let Some(dir) = &args.write_strategies {
+        if settings.integrator.kind != IntegratorKind::Bdpt {
+            eprintln!("error: --write-strategies needs --integrator bdpt");
+            return ExitCode::from(2);
+        }
+        if let Err(e) = std::fs::create_dir_all(dir) {
+            eprintln!("error: cannot make {}: {e}", dir.display());
+            return ExitCode::from(1);
+        }
+        settings.integrator.strategies = true;
+    }
     if let Err(e) = plenum_image::OutputFormat::from_path(&args.output) {
         eprintln!("error: {e}");
         return ExitCode::from(2);
@@ -533,6 +550,28 @@ fn run_render(args: RenderArgs) -> ExitCode {
     ) {
         eprintln!("error: {e}");
         return ExitCode::from(1);
+    }
+    if let Some(dir) = &args.write_strategies {
+        let ext = args
+            .output
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("exr");
+        for (s, t, weighted, plain) in &output.strategies {
+            for (film, suffix) in [(weighted, ""), (plain, "_unweighted")] {
+                let path = dir.join(format!("s{s}_t{t}{suffix}.{ext}"));
+                if let Err(e) = plenum_image::write_image(
+                    &path,
+                    film.width,
+                    film.height,
+                    film.pixels(),
+                    exposure,
+                ) {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(1);
+                }
+            }
+        }
     }
     if !args.quiet {
         let c = &output.counts;

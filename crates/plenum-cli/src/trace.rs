@@ -76,6 +76,9 @@ fn node_json(id: usize, n: &RayNode) -> Value {
         "stopped": n.stops.iter().map(|s| s.name()).collect::<Vec<_>>(),
         "total_internal_reflection": n.total_internal_reflection,
     });
+    if let Some(s) = &n.strategy {
+        v["strategy"] = json!({"s": s.s, "t": s.t, "mis_weight": s.mis_weight, "unweighted": rgb(s.unweighted)});
+    }
     if let Some(s) = &n.shadow {
         v["light"] = json!(s.light);
         v["blocked"] = json!(s.blocked);
@@ -127,6 +130,16 @@ fn print_node(out: &mut String, tree: &RayTree, id: usize, indent: usize) {
             out,
             "{pad}  hit \"{object}\" (material \"{material}\") at distance {:.4}",
             n.distance.unwrap_or(0.0)
+        );
+    }
+    if let Some(s) = &n.strategy {
+        let _ = writeln!(
+            out,
+            "{pad}  strategy s = {}, t = {}: unweighted {}, MIS weight {:.4}",
+            s.s,
+            s.t,
+            fmt_color(s.unweighted),
+            s.mis_weight
         );
     }
     if n.total_internal_reflection {

@@ -13,7 +13,9 @@
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::{Film, SplatBuffer};
-use crate::integrator::{Integrator, IntegratorConfig, RayCounts, RayTree};
+use crate::integrator::{
+    Integrator, IntegratorConfig, IntegratorKind, RayCounts, RayTree, StrategyImages,
+};
 use crate::sampling::{Filter, PixelSampler, Rng, SampleStream};
 use crate::scene::Scene;
 use rayon::prelude::*;
@@ -106,6 +108,9 @@ pub struct RenderOutput {
     pub counts: RayCounts,
     /// False when the render was cancelled: tiles not yet rendered are black.
     pub complete: bool,
+    /// Bidirectional path tracing with `strategies` set: for each strategy (s, t), its
+    /// image weighted by MIS and unweighted.
+    pub strategies: Vec<(usize, usize, Film, Film)>,
 }
 
 /// Renders the scene. `cancel` stops the render between tiles; `progress(done, total)` is
@@ -124,7 +129,24 @@ pub fn render(
     } else {
         SplatBuffer::new(0, 0, 0.0)
     };
-    let integrator = Integrator::new(scene, &settings.integrator, &camera, &splats);
+    let strategies = (settings.integrator.strategies
+        && settings.integrator.kind == IntegratorKind::Bdpt)
+        .then(|| {
+            let spp = settings.sampler.samples_per_pixel().max(1);
+            StrategyImages::new(
+                settings.width,
+                settings.height,
+                1.0 / spp as f64,
+                settings.integrator.max_depth,
+            )
+        });
+    let integrator = Integrator::new(
+        scene,
+        &settings.integrator,
+        &camera,
+        &splats,
+        strategies.as_ref(),
+    );
     // In corner mode the grid rendered is that of the corners, one ray each.
     let extra = u32::from(settings.corners);
     let (w, h) = (settings.width + extra, settings.height + extra);
@@ -202,7 +224,22 @@ pub fn render(
     film.add_splats(&splats);
     film.resolve(1.0);
     counts.invalid += splats.clamped();
+    let strategies = strategies.map_or_else(Vec::new, |si| {
+        let film_of = |b: &SplatBuffer| {
+            let mut f = Film::new(settings.width, settings.height);
+            f.add_splats(b);
+            f.resolve(1.0);
+            f
+        };
+        si.strategies()
+            .map(|(s, t)| {
+                let (weighted, plain) = &si.images[si.index(s, t)];
+                (s, t, film_of(weighted), film_of(plain))
+            })
+            .collect()
+    });
     RenderOutput {
+        strategies,
         film: if settings.corners {
             average_corners(&film)
         } else {
@@ -547,7 +584,7 @@ fn corner_stream(seed: u64, x: u32, y: u32) -> SampleStream {
 pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> (RayTree, Color) {
     let camera = Camera::new(&scene.camera, settings.width, settings.height);
     let splats = SplatBuffer::new(settings.width, settings.height, 1.0);
-    let integrator = Integrator::new(scene, &settings.integrator, &camera, &splats);
+    let integrator = Integrator::new(scene, &settings.integrator, &camera, &splats, None);
     let mut tree = RayTree::default();
     let mut counts = RayCounts::default();
     let c = render_pixel(

@@ -266,11 +266,16 @@ pub(super) fn leave_light(es: &EmissionSample) -> Ray {
 /// |ωi·n_s| for a path carrying importance, with Veach's shading-normal correction:
 /// |ωo·n_s||ωi·n_g| / |ωo·n_g| (thesis §5.3; the |ωi·n_s| of the cosine cancels).
 pub(super) fn adjoint_cosine(it: &Interaction, wo: Vec3, wi: Vec3) -> f64 {
-    let wo_ng = wo.dot(it.n).abs();
+    adjoint_cosine_of(it.n, it.shading_n, wo, wi)
+}
+
+/// [`adjoint_cosine`] for the geometric normal `n` and shading normal `ns`.
+pub(super) fn adjoint_cosine_of(n: Vec3, ns: Vec3, wo: Vec3, wi: Vec3) -> f64 {
+    let wo_ng = wo.dot(n).abs();
     if wo_ng == 0.0 {
         return 0.0;
     }
-    wo.dot(it.shading_n).abs() * wi.dot(it.n).abs() / wo_ng
+    wo.dot(ns).abs() * wi.dot(n).abs() / wo_ng
 }
 
 /// A sample's spectrum as linear sRGB.

@@ -4,16 +4,18 @@
 //! [`Integrator::camera_ray`] for each camera sample (pbrt-v4's `RayIntegrator::Li` under its
 //! `ImageTileIntegrator`). The integrator is chosen once per render, and dispatched by `match`.
 
+mod bdpt;
 mod light_tracing;
 mod medium;
 mod path;
 mod ray_tree;
 mod whitted;
 
+pub use bdpt::{BidirectionalPathTracer, StrategyImages};
 pub use light_tracing::LightTracer;
 pub use medium::MediumStack;
 pub use path::PathTracer;
-pub use ray_tree::{RayKind, RayNode, RayTree, ShadowInfo, Stop};
+pub use ray_tree::{RayKind, RayNode, RayTree, ShadowInfo, Stop, Strategy};
 pub use whitted::{RayCounts, Whitted, WhittedConfig, MAX_DEPTH};
 
 use crate::camera::Camera;
@@ -105,6 +107,8 @@ pub struct IntegratorConfig {
     pub rr_depth: u32,
     /// How light is represented: by sampled wavelengths or by three RGB channels.
     pub color: ColorMode,
+    /// Bidirectional path tracing: keep the image of every strategy (s, t).
+    pub strategies: bool,
 }
 
 impl Default for IntegratorConfig {
@@ -116,6 +120,7 @@ impl Default for IntegratorConfig {
             min_weight: w.min_weight,
             rr_depth: 5,
             color: ColorMode::Spectral,
+            strategies: false,
         }
     }
 }
@@ -138,15 +143,18 @@ pub enum Integrator<'a> {
     Whitted(Whitted<'a>),
     Path(PathTracer<'a>),
     Light(LightTracer<'a>),
+    Bdpt(BidirectionalPathTracer<'a>),
 }
 
 impl<'a> Integrator<'a> {
-    /// The integrator for `config`; those that splat add to `splats`, through `camera`.
+    /// The integrator for `config`; those that splat add to `splats`, through `camera`;
+    /// bidirectional path tracing also writes each strategy's image to `strategies`.
     pub fn new(
         scene: &'a Scene,
         config: &IntegratorConfig,
         camera: &'a Camera,
         splats: &'a SplatBuffer,
+        strategies: Option<&'a StrategyImages>,
     ) -> Self {
         match config.kind {
             IntegratorKind::Local | IntegratorKind::Appel | IntegratorKind::Whitted => {
@@ -157,7 +165,10 @@ impl<'a> Integrator<'a> {
                 Integrator::Light(LightTracer::new(scene, config, camera, splats))
             }
             // Not yet written: the path tracer stands in.
-            IntegratorKind::Photon | IntegratorKind::Sppm | IntegratorKind::Bdpt => {
+            IntegratorKind::Bdpt => Integrator::Bdpt(BidirectionalPathTracer::new(
+                scene, config, camera, splats, strategies,
+            )),
+            IntegratorKind::Photon | IntegratorKind::Sppm => {
                 Integrator::Path(PathTracer::new(scene, config))
             }
         }
@@ -177,6 +188,7 @@ impl<'a> Integrator<'a> {
             Integrator::Whitted(w) => w.camera_ray(ray, stream, counts, tree),
             Integrator::Path(p) => p.camera_ray(ray, stream, counts, tree),
             Integrator::Light(l) => l.camera_ray(ray, stream, counts, tree),
+            Integrator::Bdpt(b) => b.camera_ray(ray, stream, counts, tree),
         }
     }
 }

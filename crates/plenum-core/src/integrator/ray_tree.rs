@@ -89,6 +89,20 @@ pub struct RayNode {
     /// At this hit the refracted ray was totally internally reflected.
     pub total_internal_reflection: bool,
     pub shadow: Option<ShadowInfo>,
+    /// For a bidirectional connection: which strategy it is and how it was weighed.
+    pub strategy: Option<Strategy>,
+}
+
+/// One connection strategy of bidirectional path tracing: s vertices from the light, t from
+/// the camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Strategy {
+    pub s: u32,
+    pub t: u32,
+    /// Its multiple importance sampling weight.
+    pub mis_weight: f64,
+    /// Its contribution before weighting, linear sRGB.
+    pub unweighted: Color,
 }
 
 impl RayNode {
@@ -114,6 +128,7 @@ impl RayNode {
             stops: Vec::new(),
             total_internal_reflection: false,
             shadow: None,
+            strategy: None,
         }
     }
 }

@@ -365,6 +365,8 @@ pub struct LightSample {
     pub distance: f64,
     /// The light's point, for aiming shadow rays; None at infinity.
     pub position: Option<Vec3>,
+    /// The unit normal of an area light's surface at that point.
+    pub normal: Option<Vec3>,
     /// What multiplies the light's radiance (or intensity): 1/d² and a spot's falloff for
     /// point lights, 0 for an area light seen from its dark side, 1 otherwise.
     pub scale: f64,
@@ -441,6 +443,7 @@ impl Light {
                     wi,
                     distance: d,
                     position: Some(q),
+                    normal: Some(n),
                     scale: if lit { 1.0 } else { 0.0 },
                     pdf,
                     delta: false,
@@ -454,6 +457,7 @@ impl Light {
                     wi,
                     distance: f64::INFINITY,
                     position: None,
+                    normal: None,
                     scale: 1.0,
                     pdf: 1.0 / (4.0 * std::f64::consts::PI),
                     delta: false,
@@ -467,6 +471,7 @@ impl Light {
                     wi,
                     distance: f64::INFINITY,
                     position: None,
+                    normal: None,
                     scale: 1.0,
                     pdf,
                     delta: false,
@@ -490,6 +495,7 @@ impl Light {
                     wi: inc.wi,
                     distance: inc.distance,
                     position: inc.position,
+                    normal: None,
                     scale: falloff / d2,
                     pdf: 1.0,
                     delta: true,
@@ -501,6 +507,7 @@ impl Light {
                 wi: -direction,
                 distance: f64::INFINITY,
                 position: None,
+                normal: None,
                 scale: 1.0,
                 pdf: 1.0,
                 delta: true,

@@ -1,9 +1,12 @@
 //! What the integration tests share.
 
+pub mod integrators;
+
 use std::path::PathBuf;
 
 /// Whether ../shared/data is beside the repository: its tests have nothing to read without
 /// it, and say so.
+#[allow(dead_code)]
 pub fn shared_data_present() -> bool {
     let present = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/data")

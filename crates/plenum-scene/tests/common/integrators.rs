@@ -1,0 +1,197 @@
+//! What the integrators' tests share: scenes, settings, pbrt-v4's analytic furnace, and
+//! Mitsuba 3's per-pixel image test against the Cornell box reference.
+#![allow(dead_code)]
+
+use plenum_core::integrator::{ColorMode, IntegratorConfig, IntegratorKind};
+use plenum_core::render::{render, RenderSettings};
+use plenum_core::sampling::{PixelSampler, SamplerKind};
+use plenum_scene::{load_scene, parse_scene, LoadedScene};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+pub fn scene(text: &str) -> LoadedScene {
+    parse_scene(Path::new("test.toml"), text, Path::new(".")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Settings for rendering `l` with `kind` at `spp` random samples per pixel.
+pub fn settings_for(
+    l: &LoadedScene,
+    kind: IntegratorKind,
+    spp: u32,
+    color: ColorMode,
+    seed: u64,
+) -> RenderSettings {
+    RenderSettings {
+        width: l.defaults.width,
+        height: l.defaults.height,
+        sampler: PixelSampler::new(SamplerKind::Random, spp),
+        integrator: IntegratorConfig {
+            kind,
+            max_depth: l.defaults.max_depth,
+            rr_depth: l.defaults.rr_depth,
+            color,
+            ..Default::default()
+        },
+        seed,
+        ..Default::default()
+    }
+}
+
+pub fn path_settings(l: &LoadedScene, spp: u32, color: ColorMode, seed: u64) -> RenderSettings {
+    settings_for(l, IntegratorKind::Path, spp, color, seed)
+}
+
+pub fn draw(l: &LoadedScene, settings: &RenderSettings) -> Vec<[f32; 3]> {
+    let out = render(&l.scene, settings, &AtomicBool::new(false), &|_, _| {});
+    assert_eq!(
+        out.counts.invalid, 0,
+        "no sample may come out NaN or infinite"
+    );
+    out.film.pixels().to_vec()
+}
+
+pub fn mean(pixels: &[[f32; 3]]) -> [f64; 3] {
+    let mut m = [0.0; 3];
+    for p in pixels {
+        for c in 0..3 {
+            m[c] += p[c] as f64;
+        }
+    }
+    m.map(|v| v / pixels.len() as f64)
+}
+
+/// The camera inside a sphere of radius 1 and reflectance 0.5: pbrt-v4's analytic scenes.
+pub fn furnace(light: &str, sphere_emission: &str) -> String {
+    format!(
+        r#"
+[render]
+max_depth = 100
+rr_depth = 5
+
+[camera]
+position = [0, 0, 0]
+look_at = [0, 0, -1]
+fov = 90
+resolution = [12, 12]
+
+[materials.half]
+type = "diffuse"
+reflectance = 0.5
+
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "half"
+{sphere_emission}
+
+{light}
+"#
+    )
+}
+
+pub fn cbox_reference(file: &str) -> Option<PathBuf> {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/references/cbox")
+        .join(file);
+    p.exists().then_some(p)
+}
+
+pub fn read_exr(p: &Path) -> Vec<[f32; 3]> {
+    plenum_image::read_float_image(p)
+        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+        .pixels
+}
+
+/// Mitsuba 3's image test on the Cornell box, rendered by `kind`: `renders` independent renders of `spp` samples
+/// give each pixel channel a mean and the variance of that mean; z = |mean − ref| /
+/// √(var + var_ref); a channel passes when 2(1 − Φ(z)) > α = 1 − 0.99^(1/N). At least 99.75 %
+/// must pass, and the squared error must be what the two variances predict (its ratio to
+/// them within 0.8–1.25).
+pub fn cbox_z_test(kind: IntegratorKind, color: ColorMode, reference: &str, variance: &str) {
+    let (Some(r), Some(v)) = (cbox_reference(reference), cbox_reference(variance)) else {
+        eprintln!("../shared/data/references/cbox is not here: the Cornell box z-test has nothing to compare with");
+        return;
+    };
+    let (reference, ref_var) = (read_exr(&r), read_exr(&v));
+    let l = load_cornell_box();
+    let (renders, spp) = (16u64, 16);
+    let images: Vec<Vec<[f32; 3]>> = (0..renders)
+        .map(|seed| draw(&l, &settings_for(&l, kind, spp, color, 1000 + seed)))
+        .collect();
+    assert_eq!(images[0].len(), reference.len());
+    let n = (reference.len() * 3) as f64;
+    let alpha = 1.0 - 0.99f64.powf(1.0 / n);
+    let z_max = normal_quantile(1.0 - alpha / 2.0);
+    let (mut pass, mut squared, mut predicted) = (0usize, 0.0, 0.0);
+    for i in 0..reference.len() {
+        for c in 0..3 {
+            let xs: Vec<f64> = images.iter().map(|im| im[i][c] as f64).collect();
+            let m = xs.iter().sum::<f64>() / renders as f64;
+            let var =
+                xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / ((renders - 1) * renders) as f64;
+            let d = m - reference[i][c] as f64;
+            let total = var + ref_var[i][c] as f64;
+            if total == 0.0 && d == 0.0 || d.abs() <= z_max * total.sqrt() {
+                pass += 1;
+            }
+            squared += d * d;
+            predicted += total;
+        }
+    }
+    let rate = pass as f64 / n;
+    let ratio = squared / predicted;
+    eprintln!(
+        "Cornell box, {}, {color:?}, {} spp: {:.4} % of pixel channels pass (z ≤ {z_max:.2}); squared error / predicted = {ratio:.3}",
+        kind.name(),
+        renders * spp as u64,
+        100.0 * rate
+    );
+    assert!(rate >= 0.9975, "only {:.3} % passed", 100.0 * rate);
+    assert!(
+        (0.8..=1.25).contains(&ratio),
+        "squared error is {ratio} × what noise predicts"
+    );
+}
+
+/// Φ⁻¹(p) by bisection on the complementary error function's series (erfc from
+/// Numerical Recipes' Chebyshev fit, relative error < 1.2e-7).
+pub fn normal_quantile(p: f64) -> f64 {
+    let erfc = |x: f64| {
+        let z = x.abs();
+        let t = 1.0 / (1.0 + 0.5 * z);
+        let r = t
+            * (-z * z - 1.26551223
+                + t * (1.00002368
+                    + t * (0.37409196
+                        + t * (0.09678418
+                            + t * (-0.18628806
+                                + t * (0.27886807
+                                    + t * (-1.13520398
+                                        + t * (1.48851587
+                                            + t * (-0.82215223 + t * 0.17087277)))))))))
+                .exp();
+        if x >= 0.0 {
+            r
+        } else {
+            2.0 - r
+        }
+    };
+    let cdf = |x: f64| 1.0 - 0.5 * erfc(x / std::f64::consts::SQRT_2);
+    let (mut lo, mut hi) = (-40.0, 40.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if cdf(mid) < p {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// scenes/cornell-box.toml, the box of the Mitsuba reference in the native format.
+pub fn load_cornell_box() -> LoadedScene {
+    let file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
+    load_scene(&file).unwrap_or_else(|e| panic!("{e}"))
+}
