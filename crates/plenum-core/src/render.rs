@@ -13,7 +13,7 @@
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::{Film, SplatBuffer};
-use crate::integrator::{Integrator, IntegratorConfig, RayCounts, RayTree};
+use crate::integrator::{Integrator, IntegratorConfig, IntegratorKind, RayCounts, RayTree};
 use crate::sampling::{Filter, PixelSampler, Rng, SampleStream};
 use crate::scene::Scene;
 use rayon::prelude::*;
@@ -56,6 +56,17 @@ impl RenderSettings {
     /// Whether the integrator can work with these settings; the reason where it cannot.
     pub fn check(&self) -> Result<(), String> {
         let kind = self.integrator.kind;
+        if matches!(kind, IntegratorKind::Photon | IntegratorKind::Sppm) {
+            self.integrator.photon.check()?;
+        }
+        if kind == IntegratorKind::Sppm {
+            if self.adaptive.is_some() || self.corners {
+                return Err("integrator `sppm` renders a fixed number of iterations (--spp): adaptive sampling and the SPD corners are not available with it".to_string());
+            }
+            if self.filter != Filter::default() {
+                return Err("integrator `sppm` gathers each pixel over its own square (a box filter of one pixel); other filters are not available with it".to_string());
+            }
+        }
         if kind.splats() {
             let name = kind.name();
             if self.adaptive.is_some() {
@@ -124,7 +135,7 @@ pub fn render(
     } else {
         SplatBuffer::new(0, 0, 0.0)
     };
-    let integrator = Integrator::new(scene, &settings.integrator, &camera, &splats);
+    let integrator = Integrator::new(scene, &settings.integrator, &camera, &splats, settings.seed);
     // In corner mode the grid rendered is that of the corners, one ray each.
     let extra = u32::from(settings.corners);
     let (w, h) = (settings.width + extra, settings.height + extra);
@@ -140,7 +151,7 @@ pub fn render(
         progress,
         passes,
     };
-    let mut counts = RayCounts::default();
+    let mut counts = integrator.pass_counts();
     let (colors, complete) = match settings.adaptive {
         Some(Adaptive::Variance {
             threshold, min_spp, ..
@@ -547,7 +558,7 @@ fn corner_stream(seed: u64, x: u32, y: u32) -> SampleStream {
 pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> (RayTree, Color) {
     let camera = Camera::new(&scene.camera, settings.width, settings.height);
     let splats = SplatBuffer::new(settings.width, settings.height, 1.0);
-    let integrator = Integrator::new(scene, &settings.integrator, &camera, &splats);
+    let integrator = Integrator::new(scene, &settings.integrator, &camera, &splats, settings.seed);
     let mut tree = RayTree::default();
     let mut counts = RayCounts::default();
     let c = render_pixel(

@@ -28,6 +28,7 @@ fn pixels(l: &LoadedScene) -> Vec<[f32; 3]> {
             min_weight: l.defaults.min_weight,
             rr_depth: l.defaults.rr_depth,
             color: l.defaults.color.unwrap_or_default(),
+            photon: l.defaults.photon,
         },
         ..Default::default()
     };
