@@ -127,6 +127,10 @@ pub fn render(
     cancel: &AtomicBool,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> RenderOutput {
+    // SPPM's iterations do not fit the per-pixel loop: it has its own.
+    if settings.integrator.kind == IntegratorKind::Sppm {
+        return crate::integrator::sppm::render(scene, settings, cancel, progress);
+    }
     let camera = Camera::new(&scene.camera, settings.width, settings.height);
     // Splats are pixel values once divided by the light paths per pixel.
     let splats = if settings.integrator.kind.splats() {

@@ -11,6 +11,7 @@ mod photon;
 pub mod photon_map;
 mod photons;
 mod ray_tree;
+pub mod sppm;
 mod whitted;
 
 pub use light_tracing::LightTracer;
@@ -241,14 +242,13 @@ impl<'a> Integrator<'a> {
             IntegratorKind::Light => {
                 Integrator::Light(LightTracer::new(scene, config, camera, splats))
             }
-            IntegratorKind::Photon => {
+            // SPPM renders by its own loop (`sppm::render`); its nearest relative here serves
+            // trace-pixel, which follows one camera sample.
+            IntegratorKind::Photon | IntegratorKind::Sppm => {
                 Integrator::Photon(Box::new(PhotonMapper::new(scene, config, camera, seed)))
             }
-            // Not yet written: the path tracer stands in. (SPPM renders by its own loop,
-            // `sppm::render`; the path tracer here serves only trace-pixel.)
-            IntegratorKind::Sppm | IntegratorKind::Bdpt => {
-                Integrator::Path(PathTracer::new(scene, config))
-            }
+            // Not yet written: the path tracer stands in.
+            IntegratorKind::Bdpt => Integrator::Path(PathTracer::new(scene, config)),
         }
     }
 

@@ -26,7 +26,7 @@
 
 use super::light_tracing::rgb;
 use super::photon_map::{Nearest, Photon, PhotonMap, Query};
-use super::photons::{direct_light, shading_correction, PhotonTracer};
+use super::photons::{direct_light, emitted, escaped, shading_correction, PhotonTracer};
 use super::{IntegratorConfig, PhotonConfig, RayCounts, RayKind, RayNode, RayTree};
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
@@ -148,13 +148,13 @@ impl<'a> PhotonMapper<'a> {
             });
             parent = node;
             let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
-                l += beta * self.escaped(ray.direction.normalized(), wl, true);
+                l += beta * escaped(self.scene, ray.direction.normalized(), wl, true);
                 break;
             };
             let it = scene.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
             // Only the camera ray and specular bounces get here: emitters count in full.
-            l += beta * self.emitted(prim, &it, wo, wl);
+            l += beta * emitted(self.scene, prim, &it, wo, wl);
             let Some(bsdf) = scene.bsdf(&it, wo, wl) else {
                 break;
             };
@@ -226,13 +226,13 @@ impl<'a> PhotonMapper<'a> {
                     break;
                 }
                 let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
-                    sum += w * self.escaped(ray.direction.normalized(), wl, delta);
+                    sum += w * escaped(self.scene, ray.direction.normalized(), wl, delta);
                     break;
                 };
                 let it = scene.interaction(&ray, prim, &hit);
                 let wo_z = -ray.direction.normalized();
                 if delta {
-                    sum += w * self.emitted(prim, &it, wo_z, wl);
+                    sum += w * emitted(self.scene, prim, &it, wo_z, wl);
                 } else if let Some(ke) = scene.phong_emission(&it, wl) {
                     sum += w * ke;
                 }
@@ -310,38 +310,6 @@ impl<'a> PhotonMapper<'a> {
             sum += f * self.scene.rgb_radiance(power, wl) * shading_correction(it, wi);
         }
         sum / (std::f64::consts::PI * r2)
-    }
-
-    /// What an emitter hit by the camera ray or a specular chain shows toward `wo`.
-    fn emitted(
-        &self,
-        prim: u32,
-        it: &Interaction,
-        wo: Vec3,
-        wl: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        let scene = self.scene;
-        if let Some(light) = scene.light_of(prim) {
-            if scene.lights[light as usize].emits_toward(it.n, wo) {
-                return scene.light_spectrum(light, wl);
-            }
-        } else if let Some(ke) = scene.phong_emission(it, wl) {
-            return ke;
-        }
-        SampledSpectrum::ZERO
-    }
-
-    /// Radiance from infinity along `d`: the background, and the lights at infinity where
-    /// no other strategy finds them (`lights`: the ray came by specular bounces only).
-    fn escaped(&self, d: Vec3, wl: &SampledWavelengths, lights: bool) -> SampledSpectrum {
-        let scene = self.scene;
-        let mut le = scene.background_spectrum(wl);
-        if lights {
-            for &i in &scene.infinite_lights {
-                le += scene.radiance_from_infinity(i, d, wl);
-            }
-        }
-        le
     }
 }
 

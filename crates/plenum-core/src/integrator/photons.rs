@@ -208,3 +208,39 @@ pub(super) fn direct_light(
     };
     f * le / (pmf * ls.pdf)
 }
+
+/// What an emitter hit by the camera ray or a specular chain shows toward `wo` (a light's
+/// surface, or a Phong material's k_e), in full.
+pub(super) fn emitted(
+    scene: &Scene,
+    prim: u32,
+    it: &Interaction,
+    wo: Vec3,
+    wl: &SampledWavelengths,
+) -> SampledSpectrum {
+    if let Some(light) = scene.light_of(prim) {
+        if scene.lights[light as usize].emits_toward(it.n, wo) {
+            return scene.light_spectrum(light, wl);
+        }
+    } else if let Some(ke) = scene.phong_emission(it, wl) {
+        return ke;
+    }
+    SampledSpectrum::ZERO
+}
+
+/// Radiance from infinity along `d`: the background, and the lights at infinity where no
+/// other strategy finds them (`lights`: the ray came by specular bounces only).
+pub(super) fn escaped(
+    scene: &Scene,
+    d: Vec3,
+    wl: &SampledWavelengths,
+    lights: bool,
+) -> SampledSpectrum {
+    let mut le = scene.background_spectrum(wl);
+    if lights {
+        for &i in &scene.infinite_lights {
+            le += scene.radiance_from_infinity(i, d, wl);
+        }
+    }
+    le
+}
