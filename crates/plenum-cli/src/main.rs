@@ -116,6 +116,29 @@ struct ViewArgs {
     /// power; the default) or uniform.
     #[arg(long)]
     light_sampler: Option<LightSamplerArg>,
+    /// Photon mapping: photon paths traced for the global map (default 200000).
+    #[arg(long)]
+    photons: Option<u64>,
+    /// Photon mapping: photon paths traced for the caustic map (default 200000; 0: none).
+    #[arg(long)]
+    caustic_photons: Option<u64>,
+    /// Photon mapping: photons per density estimate, k (default 64).
+    #[arg(long)]
+    photon_nearest: Option<u32>,
+    /// Photon mapping: the largest gather radius; SPPM: the initial radius, in scene units
+    /// (default 0: automatic).
+    #[arg(long)]
+    photon_radius: Option<f64>,
+    /// Photon mapping: final-gather rays per camera sample (default 1).
+    #[arg(long)]
+    gather_rays: Option<u32>,
+    /// SPPM: photon paths per iteration (default 0: the image's pixel count); the
+    /// iterations are --spp.
+    #[arg(long)]
+    sppm_photons: Option<u64>,
+    /// SPPM: the fraction α of new photons kept as a pixel's radius shrinks (default 2/3).
+    #[arg(long)]
+    sppm_alpha: Option<f64>,
     /// Random seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -406,6 +429,18 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
             eprintln!("warning: {what} needs wavelengths: in RGB mode it is rendered at 589.3 nm (use --color spectral)");
         }
     }
+    let mut photon = d.photon;
+    photon.photons = view.photons.unwrap_or(photon.photons);
+    photon.caustic_photons = view.caustic_photons.unwrap_or(photon.caustic_photons);
+    photon.nearest = view.photon_nearest.unwrap_or(photon.nearest);
+    photon.radius = view.photon_radius.unwrap_or(photon.radius);
+    photon.gather_rays = view.gather_rays.unwrap_or(photon.gather_rays);
+    photon.sppm_photons = view.sppm_photons.unwrap_or(photon.sppm_photons);
+    photon.alpha = view.sppm_alpha.unwrap_or(photon.alpha);
+    if let Err(e) = photon.check() {
+        eprintln!("error: {e} (--photons, --caustic-photons, --photon-nearest, --photon-radius, --gather-rays, --sppm-photons, --sppm-alpha)");
+        return Err(ExitCode::from(2));
+    }
     let settings = RenderSettings {
         width,
         height,
@@ -419,6 +454,7 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
             rr_depth: view.rr_depth.unwrap_or(d.rr_depth),
             color,
             strategies: false,
+            photon,
         },
         seed: view.seed,
         corners: view.nff_corners,

@@ -249,7 +249,9 @@ fn bad_scenes_give_located_errors() {
             "4:5",
             "expected k ≥ 0",
         ),
-        ("[render]\nintegrator = \"photon\"\n", "2:14", "unknown integrator"),
+        ("[render]\nintegrator = \"photons\"\n", "2:14", "unknown integrator"),
+        ("[render]\nphoton_nearest = 0\n", "2:18", "density estimate"),
+        ("[render]\nsppm_alpha = 1\n", "2:14", "alpha"),
         ("[render]\ncolor = \"hsv\"\n", "2:9", "unknown colour mode"),
         (
             "[[lights]]\ntype = \"point\"\nposition = [0, 1, 0]\nspectrum = { spectrum = [[500, 1], [400, 2]] }\n",
@@ -518,4 +520,59 @@ fn bench_rejects_bad_rays_files_and_arguments() {
     let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(report["hit_fraction"], 1.0);
     assert!(report.get("baseline").is_none());
+}
+
+/// Bad photon settings on the command line exit with 2 and say what is wrong; good ones
+/// render with `photon` and `sppm`.
+#[test]
+fn photon_flags_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    let run = |args: &[&str]| {
+        plenum()
+            .arg("render")
+            .args(["--width", "8", "--height", "8", "-o"])
+            .arg(&out)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    for (args, says) in [
+        (
+            &["--integrator", "sppm", "--sppm-alpha", "1.5"][..],
+            "alpha",
+        ),
+        (&["--integrator", "photon", "--photons", "0"][..], "photons"),
+        (
+            &["--integrator", "photon", "--gather-rays", "0"][..],
+            "final-gather",
+        ),
+        (
+            &["--integrator", "photon", "--photon-radius=-1"][..],
+            "radius",
+        ),
+        (
+            &["--integrator", "sppm", "--filter", "gaussian"][..],
+            "box filter",
+        ),
+    ] {
+        let o = run(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        assert!(stderr(&o).contains(says), "{args:?}: {}", stderr(&o));
+    }
+    for method in ["photon", "sppm"] {
+        let o = run(&[
+            "--integrator",
+            method,
+            "--photons",
+            "2000",
+            "--caustic-photons",
+            "500",
+            "--sppm-photons",
+            "500",
+            "--spp",
+            "4",
+        ]);
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+    }
 }

@@ -58,6 +58,17 @@ impl RenderSettings {
     /// Whether the integrator can work with these settings; the reason where it cannot.
     pub fn check(&self) -> Result<(), String> {
         let kind = self.integrator.kind;
+        if matches!(kind, IntegratorKind::Photon | IntegratorKind::Sppm) {
+            self.integrator.photon.check()?;
+        }
+        if kind == IntegratorKind::Sppm {
+            if self.adaptive.is_some() || self.corners {
+                return Err("integrator `sppm` renders a fixed number of iterations (--spp): adaptive sampling and the SPD corners are not available with it".to_string());
+            }
+            if self.filter != Filter::default() {
+                return Err("integrator `sppm` gathers each pixel over its own square (a box filter of one pixel); other filters are not available with it".to_string());
+            }
+        }
         if kind.splats() {
             let name = kind.name();
             if self.adaptive.is_some() {
@@ -121,6 +132,10 @@ pub fn render(
     cancel: &AtomicBool,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> RenderOutput {
+    // SPPM's iterations do not fit the per-pixel loop: it has its own.
+    if settings.integrator.kind == IntegratorKind::Sppm {
+        return crate::integrator::sppm::render(scene, settings, cancel, progress);
+    }
     let camera = Camera::new(&scene.camera, settings.width, settings.height);
     // Splats are pixel values once divided by the light paths per pixel.
     let splats = if settings.integrator.kind.splats() {
@@ -146,6 +161,7 @@ pub fn render(
         &camera,
         &splats,
         strategies.as_ref(),
+        settings.seed,
     );
     // In corner mode the grid rendered is that of the corners, one ray each.
     let extra = u32::from(settings.corners);
@@ -162,7 +178,7 @@ pub fn render(
         progress,
         passes,
     };
-    let mut counts = RayCounts::default();
+    let mut counts = integrator.pass_counts();
     let (colors, complete) = match settings.adaptive {
         Some(Adaptive::Variance {
             threshold, min_spp, ..
@@ -584,7 +600,14 @@ fn corner_stream(seed: u64, x: u32, y: u32) -> SampleStream {
 pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> (RayTree, Color) {
     let camera = Camera::new(&scene.camera, settings.width, settings.height);
     let splats = SplatBuffer::new(settings.width, settings.height, 1.0);
-    let integrator = Integrator::new(scene, &settings.integrator, &camera, &splats, None);
+    let integrator = Integrator::new(
+        scene,
+        &settings.integrator,
+        &camera,
+        &splats,
+        None,
+        settings.seed,
+    );
     let mut tree = RayTree::default();
     let mut counts = RayCounts::default();
     let c = render_pixel(

@@ -45,6 +45,8 @@ pub struct RenderDefaults {
     pub light_sampler: plenum_core::light_sampler::LightSamplerKind,
     /// NFF's view angle between the outermost rays, for the SPD corner-ray procedure.
     pub nff_angle: Option<f64>,
+    /// Photon mapping's and SPPM's settings.
+    pub photon: plenum_core::integrator::PhotonConfig,
 }
 
 impl Default for RenderDefaults {
@@ -65,6 +67,7 @@ impl Default for RenderDefaults {
             rr_depth: 5,
             light_sampler: Default::default(),
             nff_angle: None,
+            photon: Default::default(),
         }
     }
 }

@@ -137,8 +137,43 @@ impl<'s> Reader<'s> {
                 "color",
                 "rr_depth",
                 "light_sampler",
+                "photons",
+                "caustic_photons",
+                "photon_nearest",
+                "photon_radius",
+                "gather_rays",
+                "sppm_photons",
+                "sppm_alpha",
             ],
         )?;
+        // Each photon setting is checked as it is read, so an error points at its key.
+        for key in [
+            "photons",
+            "caustic_photons",
+            "photon_nearest",
+            "photon_radius",
+            "gather_rays",
+            "sppm_photons",
+            "sppm_alpha",
+        ] {
+            let Some(v) = f.get(key) else { continue };
+            let p = &mut d.photon;
+            match key {
+                "photon_radius" => p.radius = f.non_negative_or(key, p.radius)?,
+                "sppm_alpha" => p.alpha = f.number_or(key, p.alpha)?,
+                _ => {
+                    let n = f.count(key)?.unwrap_or(0);
+                    match key {
+                        "photons" => p.photons = n as u64,
+                        "caustic_photons" => p.caustic_photons = n as u64,
+                        "photon_nearest" => p.nearest = n,
+                        "gather_rays" => p.gather_rays = n,
+                        _ => p.sppm_photons = n as u64,
+                    }
+                }
+            }
+            p.check().map_err(|e| self.src.error(v.span(), e))?;
+        }
         if let Some(v) = f.get("integrator") {
             let name = self.src.string(v)?;
             d.integrator = Some(IntegratorKind::from_name(name).ok_or_else(|| {

@@ -58,6 +58,28 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
         "rr_depth = {}\nlight_sampler = \"{sampler}\"",
         defaults.rr_depth
     );
+    // The photon methods' settings, where they differ from the defaults.
+    let (p, base) = (
+        &defaults.photon,
+        plenum_core::integrator::PhotonConfig::default(),
+    );
+    for (key, value, default) in [
+        ("photons", p.photons, base.photons),
+        ("caustic_photons", p.caustic_photons, base.caustic_photons),
+        ("photon_nearest", p.nearest as u64, base.nearest as u64),
+        ("gather_rays", p.gather_rays as u64, base.gather_rays as u64),
+        ("sppm_photons", p.sppm_photons, base.sppm_photons),
+    ] {
+        if value != default {
+            let _ = writeln!(w, "{key} = {value}");
+        }
+    }
+    if p.radius != base.radius {
+        let _ = writeln!(w, "photon_radius = {:?}", p.radius);
+    }
+    if p.alpha != base.alpha {
+        let _ = writeln!(w, "sppm_alpha = {:?}", p.alpha);
+    }
     let _ = writeln!(w);
     let c = &scene.camera;
     let _ = writeln!(

@@ -29,6 +29,7 @@ fn pixels(l: &LoadedScene) -> Vec<[f32; 3]> {
             rr_depth: l.defaults.rr_depth,
             color: l.defaults.color.unwrap_or_default(),
             strategies: false,
+            photon: l.defaults.photon,
         },
         ..Default::default()
     };

@@ -8,13 +8,18 @@ mod bdpt;
 mod light_tracing;
 mod medium;
 mod path;
+mod photon;
+pub mod photon_map;
+mod photons;
 mod ray_tree;
+pub mod sppm;
 mod whitted;
 
 pub use bdpt::{BidirectionalPathTracer, StrategyImages};
 pub use light_tracing::LightTracer;
 pub use medium::MediumStack;
 pub use path::PathTracer;
+pub use photon::PhotonMapper;
 pub use ray_tree::{RayKind, RayNode, RayTree, ShadowInfo, Stop, Strategy};
 pub use whitted::{RayCounts, Whitted, WhittedConfig, MAX_DEPTH};
 
@@ -109,6 +114,83 @@ pub struct IntegratorConfig {
     pub color: ColorMode,
     /// Bidirectional path tracing: keep the image of every strategy (s, t).
     pub strategies: bool,
+    /// Photon mapping's and SPPM's settings.
+    pub photon: PhotonConfig,
+}
+
+/// The settings of the photon methods (`photon`, `sppm`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhotonConfig {
+    /// Photon mapping: photon paths traced for the global map.
+    pub photons: u64,
+    /// Photon mapping: photon paths traced for the caustic map (0: no caustic map, and no
+    /// caustics).
+    pub caustic_photons: u64,
+    /// Photon mapping: the photons a density estimate gathers (k), 1 to [`MAX_NEAREST`].
+    pub nearest: u32,
+    /// Photon mapping: the largest gather radius; SPPM: the initial radius (scene units).
+    /// 0: automatic (a tenth of the scene's bounding radius; for SPPM, two pixels' footprint
+    /// at each pixel's first visible point).
+    pub radius: f64,
+    /// Photon mapping: final-gather rays per camera sample.
+    pub gather_rays: u32,
+    /// SPPM: photon paths per iteration (0: as many as the image has pixels).
+    pub sppm_photons: u64,
+    /// SPPM: the fraction of new photons kept as the radius shrinks, in (0, 1).
+    pub alpha: f64,
+}
+
+/// The most photons one density estimate may gather (the search keeps one more).
+pub const MAX_NEAREST: u32 = photon_map::MAX_NEAREST as u32 - 1;
+
+impl Default for PhotonConfig {
+    fn default() -> Self {
+        PhotonConfig {
+            photons: 200_000,
+            caustic_photons: 200_000,
+            nearest: 64,
+            radius: 0.0,
+            gather_rays: 1,
+            sppm_photons: 0,
+            alpha: 2.0 / 3.0,
+        }
+    }
+}
+
+impl PhotonConfig {
+    /// The largest photon count a setting takes: 2³² paths.
+    pub const MAX_PHOTONS: u64 = 1 << 32;
+
+    /// Whether the settings make sense; what is wrong where they do not.
+    pub fn check(&self) -> Result<(), String> {
+        if self.photons == 0 || self.photons > Self::MAX_PHOTONS {
+            return Err(format!(
+                "photons must be between 1 and {} photon paths",
+                Self::MAX_PHOTONS
+            ));
+        }
+        if self.caustic_photons > Self::MAX_PHOTONS || self.sppm_photons > Self::MAX_PHOTONS {
+            return Err(format!(
+                "caustic and SPPM photon counts must be at most {} photon paths",
+                Self::MAX_PHOTONS
+            ));
+        }
+        if self.nearest == 0 || self.nearest > MAX_NEAREST {
+            return Err(format!(
+                "the photons per density estimate must be between 1 and {MAX_NEAREST}"
+            ));
+        }
+        if !(self.radius >= 0.0 && self.radius.is_finite()) {
+            return Err("the photon radius must be a number ≥ 0 (0: automatic)".to_string());
+        }
+        if self.gather_rays == 0 || self.gather_rays > 1024 {
+            return Err("the final-gather rays must be between 1 and 1024".to_string());
+        }
+        if !(self.alpha > 0.0 && self.alpha < 1.0) {
+            return Err("the SPPM alpha must lie strictly between 0 and 1".to_string());
+        }
+        Ok(())
+    }
 }
 
 impl Default for IntegratorConfig {
@@ -121,6 +203,7 @@ impl Default for IntegratorConfig {
             rr_depth: 5,
             color: ColorMode::Spectral,
             strategies: false,
+            photon: PhotonConfig::default(),
         }
     }
 }
@@ -144,17 +227,20 @@ pub enum Integrator<'a> {
     Path(PathTracer<'a>),
     Light(LightTracer<'a>),
     Bdpt(BidirectionalPathTracer<'a>),
+    Photon(Box<PhotonMapper<'a>>),
 }
 
 impl<'a> Integrator<'a> {
     /// The integrator for `config`; those that splat add to `splats`, through `camera`;
     /// bidirectional path tracing also writes each strategy's image to `strategies`.
+    /// Photon mapping traces its photon pass here, its random numbers from `seed`.
     pub fn new(
         scene: &'a Scene,
         config: &IntegratorConfig,
         camera: &'a Camera,
         splats: &'a SplatBuffer,
         strategies: Option<&'a StrategyImages>,
+        seed: u64,
     ) -> Self {
         match config.kind {
             IntegratorKind::Local | IntegratorKind::Appel | IntegratorKind::Whitted => {
@@ -164,12 +250,13 @@ impl<'a> Integrator<'a> {
             IntegratorKind::Light => {
                 Integrator::Light(LightTracer::new(scene, config, camera, splats))
             }
-            // Not yet written: the path tracer stands in.
             IntegratorKind::Bdpt => Integrator::Bdpt(BidirectionalPathTracer::new(
                 scene, config, camera, splats, strategies,
             )),
+            // SPPM renders by its own loop (`sppm::render`); its nearest relative here serves
+            // trace-pixel, which follows one camera sample.
             IntegratorKind::Photon | IntegratorKind::Sppm => {
-                Integrator::Path(PathTracer::new(scene, config))
+                Integrator::Photon(Box::new(PhotonMapper::new(scene, config, camera, seed)))
             }
         }
     }
@@ -189,6 +276,15 @@ impl<'a> Integrator<'a> {
             Integrator::Path(p) => p.camera_ray(ray, stream, counts, tree),
             Integrator::Light(l) => l.camera_ray(ray, stream, counts, tree),
             Integrator::Bdpt(b) => b.camera_ray(ray, stream, counts, tree),
+            Integrator::Photon(p) => p.camera_ray(ray, stream, counts, tree),
+        }
+    }
+
+    /// The rays traced before rendering (photon mapping's photon pass).
+    pub fn pass_counts(&self) -> RayCounts {
+        match self {
+            Integrator::Photon(p) => p.pass_counts,
+            _ => RayCounts::default(),
         }
     }
 }

@@ -1,0 +1,384 @@
+//! Photon mapping as Jensen (1996) does it: a photon pass before rendering fills a global
+//! map (every photon landing on a diffuse or glossy surface) and a caustic map (photons that
+//! came L S+ D: only specular bounces since the light); the eye pass follows specular
+//! bounces to the first diffuse or glossy surface and adds there
+//! - direct light, by next-event estimation ([`super::photons::direct_light`]);
+//! - caustics, the caustic map's density estimate at that point;
+//! - indirect light, by final gathering: `gather_rays` rays sampled from the BSDF, each
+//!   taking the global map's density estimate at its first diffuse or glossy hit (after
+//!   any specular bounces) as the radiance it brings back.
+//!
+//! A density estimate is Σ f(ωo, ωp)·Φp / (π r²) over the k nearest photons facing the same
+//! way, r the distance of the (k + 1)-th (which makes k/(π r²) an unbiased density for
+//! photons spread evenly on a plane), or the search bound where fewer are found.
+//!
+//! The passes are deterministic: photon path i takes its random numbers from (seed, pass, i)
+//! and chunks of paths are traced in parallel and joined in order.
+//!
+//! Colour: a photon keeps its flux as linear sRGB, from its own wavelengths; the eye pass,
+//! at other wavelengths, reads it as an RGB illuminant spectrum (as the scene's RGB lights
+//! are read). In RGB mode this is exact; spectrally it is one more source of bias, the
+//! difference between a spectral product and the product of an uplifted spectrum.
+//!
+//! Bias: density estimation blurs the global map's light over the k nearest photons (seen
+//! only after a gather bounce, so mostly where gather rays land close by: in corners) and
+//! the caustic map's caustics; docs/photon-mapping.md gives the measured values.
+
+use super::light_tracing::rgb;
+use super::photon_map::{Nearest, Photon, PhotonMap, Query};
+use super::photons::{direct_light, emitted, escaped, shading_correction, PhotonTracer};
+use super::{IntegratorConfig, PhotonConfig, RayCounts, RayKind, RayNode, RayTree};
+use crate::bxdf::{Bsdf, TransportMode};
+use crate::camera::Camera;
+use crate::color::Color;
+use crate::math::{offset_ray_origin, Ray, Vec3};
+use crate::sampling::SampleStream;
+use crate::scene::{Interaction, Scene};
+use plenum_spectrum::{ColorMode, SampledSpectrum, SampledWavelengths};
+use rayon::prelude::*;
+
+/// Photon paths traced per parallel chunk of a pass.
+const CHUNK: u64 = 4096;
+
+pub struct PhotonMapper<'a> {
+    scene: &'a Scene,
+    max_depth: u32,
+    color: ColorMode,
+    nearest: usize,
+    max_distance2: f32,
+    gather_rays: u32,
+    global: PhotonMap,
+    caustic: PhotonMap,
+    /// The rays the photon pass traced.
+    pub pass_counts: RayCounts,
+}
+
+impl<'a> PhotonMapper<'a> {
+    /// Traces the photon pass for a render with `seed`.
+    pub fn new(scene: &'a Scene, config: &IntegratorConfig, camera: &Camera, seed: u64) -> Self {
+        let p = &config.photon;
+        let tracer = PhotonTracer::new(scene, config);
+        let mut pass_counts = RayCounts::default();
+        let global = photon_pass(
+            &tracer,
+            camera,
+            config.color,
+            seed,
+            0,
+            p.photons,
+            false,
+            &mut pass_counts,
+        );
+        let caustic = photon_pass(
+            &tracer,
+            camera,
+            config.color,
+            seed,
+            1,
+            p.caustic_photons,
+            true,
+            &mut pass_counts,
+        );
+        let radius = p.max_radius(scene);
+        PhotonMapper {
+            scene,
+            max_depth: config.max_depth,
+            color: config.color,
+            nearest: p.nearest as usize,
+            max_distance2: (radius * radius) as f32,
+            gather_rays: p.gather_rays,
+            global,
+            caustic,
+            pass_counts,
+        }
+    }
+
+    /// The photons stored in the global and caustic maps.
+    pub fn photons_stored(&self) -> (usize, usize) {
+        (self.global.len(), self.caustic.len())
+    }
+
+    /// Linear sRGB radiance along a camera ray.
+    pub fn camera_ray(
+        &self,
+        ray: &Ray,
+        stream: &mut SampleStream,
+        counts: &mut RayCounts,
+        tree: Option<&mut RayTree>,
+    ) -> Color {
+        counts.camera += 1;
+        let mut wl = match self.color {
+            ColorMode::Spectral => SampledWavelengths::sample_visible(stream.next_1d()),
+            ColorMode::Rgb => SampledWavelengths::rgb(),
+        };
+        let l = self.li(ray, &mut wl, stream, counts, tree);
+        let c = rgb(l, &wl);
+        if !(l.is_finite() && c.r.is_finite() && c.g.is_finite() && c.b.is_finite()) {
+            counts.invalid += 1;
+            return Color::BLACK;
+        }
+        c
+    }
+
+    fn li(
+        &self,
+        camera_ray: &Ray,
+        wl: &mut SampledWavelengths,
+        stream: &mut SampleStream,
+        counts: &mut RayCounts,
+        mut tree: Option<&mut RayTree>,
+    ) -> SampledSpectrum {
+        let scene = self.scene;
+        let mut l = SampledSpectrum::ZERO;
+        let mut beta = SampledSpectrum::ONE;
+        let mut ray = *camera_ray;
+        let mut kind = RayKind::Camera;
+        let mut parent = None;
+        // e: the eye vertex, 1 for the camera ray's hit.
+        for e in 1..=self.max_depth + 1 {
+            let node = tree.as_deref_mut().map(|t| {
+                t.push(RayNode::new(
+                    parent,
+                    kind,
+                    e - 1,
+                    ray.origin,
+                    ray.direction,
+                    rgb(beta, wl),
+                ))
+            });
+            parent = node;
+            let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
+                l += beta * escaped(self.scene, ray.direction.normalized(), wl, true);
+                break;
+            };
+            let it = scene.interaction(&ray, prim, &hit);
+            let wo = -ray.direction.normalized();
+            // Only the camera ray and specular bounces get here: emitters count in full.
+            l += beta * emitted(self.scene, prim, &it, wo, wl);
+            let Some(bsdf) = scene.bsdf(&it, wo, wl) else {
+                break;
+            };
+            if bsdf.flags().is_non_specular() {
+                let time = ray.time;
+                l += beta * direct_light(scene, &it, wo, &bsdf, wl, stream, counts, time);
+                l += beta * self.estimate(&self.caustic, &it, wo, &bsdf, wl, e);
+                l += beta * self.gather(&it, wo, &bsdf, wl, stream, counts, e, time);
+                break;
+            }
+            if e == self.max_depth + 1 {
+                break;
+            }
+            let Some(bs) = bsdf.sample_f(
+                wo,
+                stream.next_1d(),
+                stream.next_2d(),
+                TransportMode::Radiance,
+            ) else {
+                break;
+            };
+            beta *= bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
+            if bs.is_transmission() {
+                counts.refraction += 1;
+                kind = RayKind::Refracted;
+            } else {
+                counts.reflection += 1;
+                kind = RayKind::Reflected;
+            }
+            if beta.is_black() {
+                break;
+            }
+            ray =
+                Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(ray.time);
+        }
+        l
+    }
+
+    /// Final gathering from the eye vertex `e`: the mean over the gather rays of the global
+    /// map's radiance at their first diffuse or glossy hit. Emitters a gather ray meets are
+    /// direct light (next-event estimation's) or caustics (the caustic map's), unless every
+    /// bounce from the eye vertex on was specular: that light neither strategy sees.
+    #[allow(clippy::too_many_arguments)]
+    fn gather(
+        &self,
+        x: &Interaction,
+        wo: Vec3,
+        bsdf: &Bsdf,
+        wl: &mut SampledWavelengths,
+        stream: &mut SampleStream,
+        counts: &mut RayCounts,
+        e: u32,
+        time: f64,
+    ) -> SampledSpectrum {
+        let scene = self.scene;
+        let mut sum = SampledSpectrum::ZERO;
+        for _ in 0..self.gather_rays {
+            let (uc, u) = (stream.next_1d(), stream.next_2d());
+            let Some(bs) = bsdf.sample_f(wo, uc, u, TransportMode::Radiance) else {
+                continue;
+            };
+            let mut w = bs.f * (bs.wi.dot(x.shading_n).abs() / bs.pdf);
+            let mut delta = bs.is_specular();
+            counts.reflection += 1;
+            let mut ray =
+                Ray::new(offset_ray_origin(x.p, x.p_error, x.n, bs.wi), bs.wi).at_time(time);
+            for ez in e + 1..=self.max_depth + 1 {
+                if w.is_black() {
+                    break;
+                }
+                let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
+                    sum += w * escaped(self.scene, ray.direction.normalized(), wl, delta);
+                    break;
+                };
+                let it = scene.interaction(&ray, prim, &hit);
+                let wo_z = -ray.direction.normalized();
+                if delta {
+                    sum += w * emitted(self.scene, prim, &it, wo_z, wl);
+                } else if let Some(ke) = scene.phong_emission(&it, wl) {
+                    sum += w * ke;
+                }
+                let Some(bsdf_z) = scene.bsdf(&it, wo_z, wl) else {
+                    break;
+                };
+                if bsdf_z.flags().is_non_specular() {
+                    sum += w * self.estimate(&self.global, &it, wo_z, &bsdf_z, wl, ez);
+                    break;
+                }
+                if ez == self.max_depth + 1 {
+                    break;
+                }
+                let (uc, u) = (stream.next_1d(), stream.next_2d());
+                let Some(bs) = bsdf_z.sample_f(wo_z, uc, u, TransportMode::Radiance) else {
+                    break;
+                };
+                w *= bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
+                delta &= bs.is_specular();
+                counts.reflection += 1;
+                ray =
+                    Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(time);
+            }
+        }
+        sum / self.gather_rays.max(1) as f64
+    }
+
+    /// The radiance the photons of `map` near `it` send toward `wo`, from photons no deeper
+    /// than an eye vertex `e` may join.
+    #[allow(clippy::too_many_arguments)]
+    fn estimate(
+        &self,
+        map: &PhotonMap,
+        it: &Interaction,
+        wo: Vec3,
+        bsdf: &Bsdf,
+        wl: &SampledWavelengths,
+        e: u32,
+    ) -> SampledSpectrum {
+        let max_depth = (self.max_depth + 2).saturating_sub(e);
+        if map.is_empty() || max_depth == 0 {
+            return SampledSpectrum::ZERO;
+        }
+        let k = self.nearest + 1;
+        let q = Query {
+            p: f32s(it.p),
+            n: f32s(it.n),
+            k,
+            max_distance2: self.max_distance2,
+            max_depth: max_depth.min(u16::MAX as u32) as u16,
+        };
+        let mut nearest = Nearest::default();
+        map.nearest(&q, &mut nearest);
+        let found = nearest.found();
+        // With k + 1 found the farthest only sets the radius.
+        let (r2, skip) = match nearest.farthest() {
+            Some((d2, i)) if found.len() == k => (d2 as f64, Some(i)),
+            _ => (self.max_distance2 as f64, None),
+        };
+        if r2 <= 0.0 {
+            return SampledSpectrum::ZERO;
+        }
+        let mut sum = SampledSpectrum::ZERO;
+        for &(_, i) in found {
+            if Some(i) == skip {
+                continue;
+            }
+            let ph: &Photon = map.photon(i);
+            let wi = Vec3::new(ph.wi[0] as f64, ph.wi[1] as f64, ph.wi[2] as f64);
+            let f = bsdf.f(wo, wi, TransportMode::Radiance);
+            if f.is_black() {
+                continue;
+            }
+            let power = Color::new(ph.power[0] as f64, ph.power[1] as f64, ph.power[2] as f64);
+            sum += f * self.scene.rgb_radiance(power, wl) * shading_correction(it, wi);
+        }
+        sum / (std::f64::consts::PI * r2)
+    }
+}
+
+impl PhotonConfig {
+    /// Photon mapping's largest gather radius: the setting, or a tenth of the scene's
+    /// bounding radius.
+    pub fn max_radius(&self, scene: &Scene) -> f64 {
+        if self.radius > 0.0 {
+            self.radius
+        } else {
+            0.1 * scene.scene_radius()
+        }
+    }
+}
+
+fn f32s(v: Vec3) -> [f32; 3] {
+    [v.x as f32, v.y as f32, v.z as f32]
+}
+
+/// Traces `paths` photon paths and returns their map: every arrival, or (`caustic`) only
+/// the first arrival after specular bounces only, each with its flux divided by `paths`.
+#[allow(clippy::too_many_arguments)]
+fn photon_pass(
+    tracer: &PhotonTracer,
+    camera: &Camera,
+    color: ColorMode,
+    seed: u64,
+    pass: u32,
+    paths: u64,
+    caustic: bool,
+    counts: &mut RayCounts,
+) -> PhotonMap {
+    let scale = 1.0 / paths.max(1) as f64;
+    let chunks: Vec<(Vec<Photon>, RayCounts)> = (0..paths.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            let mut photons = Vec::new();
+            let mut counts = RayCounts::default();
+            for i in c * CHUNK..((c + 1) * CHUNK).min(paths) {
+                let mut stream = PhotonTracer::stream(seed, pass, i);
+                let mut wl = match color {
+                    ColorMode::Spectral => SampledWavelengths::sample_visible(stream.next_1d()),
+                    ColorMode::Rgb => SampledWavelengths::rgb(),
+                };
+                let time = camera.time(stream.next_1d());
+                tracer.trace(time, &mut wl, &mut stream, &mut counts, |a, wl| {
+                    if caustic && !a.caustic {
+                        return false;
+                    }
+                    let power = rgb(a.beta * scale, wl);
+                    if power.r.is_finite() && power.g.is_finite() && power.b.is_finite() {
+                        photons.push(Photon::new(
+                            f32s(a.it.p),
+                            f32s(a.wi),
+                            f32s(a.it.n),
+                            [power.r as f32, power.g as f32, power.b as f32],
+                            a.depth.min(u16::MAX as u32) as u16,
+                        ));
+                    }
+                    !caustic
+                });
+            }
+            (photons, counts)
+        })
+        .collect();
+    let mut all = Vec::with_capacity(chunks.iter().map(|c| c.0.len()).sum());
+    for (photons, c) in chunks {
+        all.extend(photons);
+        counts.add(&c);
+    }
+    PhotonMap::build(all)
+}

@@ -1,0 +1,431 @@
+//! Stochastic progressive photon mapping (Hachisuka and Jensen 2009), in the structure of
+//! pbrt-v3's `SPPMIntegrator` (§16.2): iteration after iteration,
+//! 1. a camera pass traces one path per pixel through specular bounces to its first diffuse
+//!    or glossy surface, adds the light seen on the way and that point's direct light (by
+//!    next-event estimation), and leaves a *visible point* there;
+//! 2. the visible points go into a hash grid, each in every cell its radius overlaps;
+//! 3. a photon pass traces photon paths; where one lands (after at least one bounce: direct
+//!    light is the camera pass's) every visible point within its pixel's radius takes the
+//!    photon's flux times its BSDF;
+//! 4. each pixel that received M photons keeps a fraction α of them: N ← N + αM, its radius
+//!    shrinks by √((N + αM)/(N + M)) and its accumulated flux τ by the square of that.
+//!
+//! A pixel is L_d / iterations + τ / (N_e π r²), N_e the photon paths of all iterations. The
+//! radius tends to zero while the photons a pixel gathers grow without bound, so the estimate
+//! is consistent: its bias (the blur of light over the radius) vanishes as the iterations
+//! grow. The iterations are the sampler's samples per pixel.
+//!
+//! Colour: in spectral mode each iteration uses one set of wavelengths for its camera and
+//! photon passes alike (a golden-ratio sequence over the iterations), so that the product of a
+//! visible point's BSDF and a photon's flux is a product at the same wavelengths.
+//!
+//! Determinism: a pixel's camera path takes its random numbers from (seed, pixel, iteration),
+//! a photon path from (seed, iteration, index); photons add to a pixel in fixed point, whose
+//! sums do not depend on their order (see [`crate::film::SplatBuffer`]), so the image is the
+//! same for any thread count.
+//!
+//! Visible points are made at the first surface with a diffuse or glossy lobe: a BSDF that
+//! also has a specular lobe (a smooth coat) is seen there without it.
+
+use super::light_tracing::rgb;
+use super::photons::{direct_light, emitted, escaped, PhotonTracer};
+use super::RayCounts;
+use crate::bxdf::{Bsdf, TransportMode};
+use crate::camera::Camera;
+use crate::color::Color;
+use crate::film::Film;
+use crate::math::{offset_ray_origin, Ray, Vec3};
+use crate::render::{RenderOutput, RenderSettings};
+use crate::sampling::Rng;
+use crate::scene::Scene;
+use plenum_spectrum::{ColorMode, SampledSpectrum, SampledWavelengths};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, AtomicI64, AtomicU64, Ordering};
+
+/// Photon paths traced per parallel chunk.
+const CHUNK: u64 = 4096;
+/// The fixed point of the photon sums: 28 bits of fraction.
+const UNIT: f64 = 1.0 / 268_435_456.0;
+/// An automatic initial radius spans this many pixels' footprints at the visible point.
+const FOOTPRINT_PIXELS: f64 = 2.0;
+
+/// Where a pixel's camera path met its first diffuse or glossy surface, this iteration.
+#[derive(Clone, Copy)]
+struct VisiblePoint {
+    p: Vec3,
+    n: Vec3,
+    shading_n: Vec3,
+    wo: Vec3,
+    bsdf: Bsdf,
+    /// The camera path's throughput up to here.
+    beta: SampledSpectrum,
+    /// The eye vertex: 1 for the camera ray's hit.
+    depth: u32,
+    wl: SampledWavelengths,
+}
+
+/// A pixel's running estimate.
+#[derive(Clone, Copy, Default)]
+struct PixelState {
+    /// The gather radius; 0 until the pixel's first visible point sets it.
+    radius: f64,
+    /// The photons kept, N.
+    n: f64,
+    /// The flux kept, τ, linear sRGB.
+    tau: [f64; 3],
+    /// The sum over iterations of the light the camera pass found, linear sRGB.
+    ld: [f64; 3],
+    vp: Option<VisiblePoint>,
+}
+
+/// One iteration's photon sums for a pixel: flux in fixed point, and the photon count M.
+#[derive(Default)]
+struct PhotonSums {
+    phi: [AtomicI64; 3],
+    m: AtomicU64,
+}
+
+/// Renders the scene by SPPM; `cancel` stops it between iterations, `progress(done,
+/// total)` is called after each.
+pub fn render(
+    scene: &Scene,
+    settings: &RenderSettings,
+    cancel: &AtomicBool,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> RenderOutput {
+    let (w, h) = (settings.width, settings.height);
+    let camera = Camera::new(&scene.camera, w, h);
+    let config = &settings.integrator;
+    let iterations = settings.sampler.samples_per_pixel().max(1);
+    let pixel_count = w as usize * h as usize;
+    let photons = match config.photon.sppm_photons {
+        0 => pixel_count as u64,
+        n => n,
+    };
+    let alpha = config.photon.alpha;
+    let tracer = PhotonTracer::new(scene, config);
+    let mut pixels = vec![PixelState::default(); pixel_count];
+    let sums: Vec<PhotonSums> = (0..pixel_count).map(|_| PhotonSums::default()).collect();
+    let mut grid = Grid::default();
+    let mut counts = RayCounts::default();
+    let u0 = Rng::new(settings.seed, 0x5350_504d).uniform();
+    let mut done = 0u32;
+    for iteration in 0..iterations {
+        if cancel.load(Ordering::Relaxed) {
+            break;
+        }
+        let wl = match config.color {
+            ColorMode::Spectral => {
+                let u = (u0 + iteration as f64 * 0.618_033_988_749_894_9).fract();
+                SampledWavelengths::sample_visible(u)
+            }
+            ColorMode::Rgb => SampledWavelengths::rgb(),
+        };
+        let eye = Eye {
+            scene,
+            camera: &camera,
+            settings,
+            wl,
+            iteration,
+        };
+        let c = pixels
+            .par_iter_mut()
+            .enumerate()
+            .fold(RayCounts::default, |mut c, (i, px)| {
+                eye.camera_path(i as u32 % w, i as u32 / w, px, &mut c);
+                c
+            })
+            .reduce(RayCounts::default, add_counts);
+        counts.add(&c);
+
+        grid.build(&pixels);
+        let max_depth = config.max_depth;
+        let pixels_now = &pixels;
+        let grid_now = &grid;
+        let c = (0..photons.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|chunk| {
+                let mut c = RayCounts::default();
+                for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(photons) {
+                    let mut stream = PhotonTracer::stream(settings.seed, iteration, index);
+                    let mut photon_wl = wl;
+                    let time = camera.time(stream.next_1d());
+                    tracer.trace(time, &mut photon_wl, &mut stream, &mut c, |a, pwl| {
+                        if a.depth < 2 {
+                            return true;
+                        }
+                        for &i in grid_now.near(a.it.p) {
+                            let Some(vp) = &pixels_now[i as usize].vp else {
+                                continue;
+                            };
+                            let r = pixels_now[i as usize].radius;
+                            if (vp.p - a.it.p).length_squared() > r * r
+                                || vp.depth + a.depth > max_depth + 2
+                            {
+                                continue;
+                            }
+                            let f = vp.bsdf.f(vp.wo, a.wi, TransportMode::Radiance);
+                            if f.is_black() {
+                                continue;
+                            }
+                            let ng = a.wi.dot(vp.n).abs();
+                            if ng == 0.0 {
+                                continue;
+                            }
+                            let correction = a.wi.dot(vp.shading_n).abs() / ng;
+                            let both = if pwl.secondary_terminated() {
+                                pwl
+                            } else {
+                                &vp.wl
+                            };
+                            let phi = rgb(vp.beta * f * a.beta * correction, both);
+                            let s = &sums[i as usize];
+                            for (sum, v) in s.phi.iter().zip([phi.r, phi.g, phi.b]) {
+                                let units = (v / UNIT).round();
+                                if units.is_finite() && units != 0.0 {
+                                    sum.fetch_add(
+                                        units.clamp(-9e18, 9e18) as i64,
+                                        Ordering::Relaxed,
+                                    );
+                                }
+                            }
+                            s.m.fetch_add(1, Ordering::Relaxed);
+                        }
+                        true
+                    });
+                }
+                c
+            })
+            .reduce(RayCounts::default, add_counts);
+        counts.add(&c);
+
+        pixels.par_iter_mut().zip(&sums).for_each(|(px, s)| {
+            let m = s.m.swap(0, Ordering::Relaxed) as f64;
+            let phi = s
+                .phi
+                .each_ref()
+                .map(|v| v.swap(0, Ordering::Relaxed) as f64 * UNIT);
+            if m > 0.0 {
+                let n = px.n + alpha * m;
+                let shrink2 = n / (px.n + m);
+                for (tau, phi) in px.tau.iter_mut().zip(phi) {
+                    *tau = (*tau + phi) * shrink2;
+                }
+                px.n = n;
+                px.radius *= shrink2.sqrt();
+            }
+            px.vp = None;
+        });
+        done += 1;
+        progress(done as usize, iterations as usize);
+    }
+
+    let mut film = Film::new(w, h);
+    let emitted_paths = done.max(1) as f64 * photons as f64;
+    for (i, px) in pixels.iter().enumerate() {
+        let area = std::f64::consts::PI * px.radius * px.radius;
+        let l = |c: usize| {
+            let gathered = if area > 0.0 {
+                px.tau[c] / (emitted_paths * area)
+            } else {
+                0.0
+            };
+            px.ld[c] / done.max(1) as f64 + gathered
+        };
+        film.set(i as u32 % w, i as u32 / w, Color::new(l(0), l(1), l(2)));
+    }
+    RenderOutput {
+        film,
+        counts,
+        complete: done == iterations,
+        strategies: Vec::new(),
+    }
+}
+
+fn add_counts(mut a: RayCounts, b: RayCounts) -> RayCounts {
+    a.add(&b);
+    a
+}
+
+/// The camera pass of one iteration.
+struct Eye<'a> {
+    scene: &'a Scene,
+    camera: &'a Camera,
+    settings: &'a RenderSettings,
+    wl: SampledWavelengths,
+    iteration: u32,
+}
+
+impl Eye<'_> {
+    /// Traces pixel (x, y)'s camera path: adds the light it finds to `px.ld` and leaves its
+    /// visible point in `px.vp`.
+    fn camera_path(&self, x: u32, y: u32, px: &mut PixelState, counts: &mut RayCounts) {
+        let scene = self.scene;
+        let s = self.settings;
+        let mut stream = s.sampler.stream(s.seed, x, y, self.iteration);
+        let f = s.filter.sample(stream.pixel());
+        let lens = stream.next_2d();
+        let shutter = stream.next_1d();
+        let mut ray =
+            self.camera
+                .sample_ray(x as f64 + 0.5 + f.dx, y as f64 + 0.5 + f.dy, lens, shutter);
+        counts.camera += 1;
+        let mut wl = self.wl;
+        let mut l = SampledSpectrum::ZERO;
+        let mut beta = SampledSpectrum::ONE;
+        let mut distance = 0.0;
+        let max_depth = s.integrator.max_depth;
+        for e in 1..=max_depth + 1 {
+            let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
+                l += beta * escaped(scene, ray.direction.normalized(), &wl, true);
+                break;
+            };
+            distance += hit.t * ray.direction.length();
+            let it = scene.interaction(&ray, prim, &hit);
+            let wo = -ray.direction.normalized();
+            l += beta * emitted(scene, prim, &it, wo, &wl);
+            let Some(bsdf) = scene.bsdf(&it, wo, &mut wl) else {
+                break;
+            };
+            if bsdf.flags().is_non_specular() {
+                l += beta * direct_light(scene, &it, wo, &bsdf, &wl, &mut stream, counts, ray.time);
+                if px.radius == 0.0 {
+                    px.radius = match s.integrator.photon.radius {
+                        r if r > 0.0 => r,
+                        _ => FOOTPRINT_PIXELS * self.camera.pixel_footprint(distance),
+                    };
+                }
+                px.vp = Some(VisiblePoint {
+                    p: it.p,
+                    n: it.n,
+                    shading_n: it.shading_n,
+                    wo,
+                    bsdf,
+                    beta,
+                    depth: e,
+                    wl,
+                });
+                break;
+            }
+            if e == max_depth + 1 {
+                break;
+            }
+            let (uc, u) = (stream.next_1d(), stream.next_2d());
+            let Some(bs) = bsdf.sample_f(wo, uc, u, TransportMode::Radiance) else {
+                break;
+            };
+            beta *= bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
+            if bs.is_transmission() {
+                counts.refraction += 1;
+            } else {
+                counts.reflection += 1;
+            }
+            if beta.is_black() {
+                break;
+            }
+            ray =
+                Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(ray.time);
+        }
+        let c = rgb(l, &wl);
+        if l.is_finite() && c.r.is_finite() && c.g.is_finite() && c.b.is_finite() {
+            px.ld[0] += c.r;
+            px.ld[1] += c.g;
+            px.ld[2] += c.b;
+        } else {
+            counts.invalid += 1;
+        }
+        // A visible point whose throughput is not finite would poison every photon sum.
+        if px.vp.is_some_and(|vp| !vp.beta.is_finite()) {
+            px.vp = None;
+        }
+    }
+}
+
+/// The visible points of one iteration in a uniform grid of cells hashed into buckets
+/// (Teschner et al. 2003's spatial hash), each point in every cell its radius overlaps. The
+/// buffers are kept from one iteration to the next.
+#[derive(Default)]
+struct Grid {
+    origin: Vec3,
+    cell: f64,
+    /// (bucket, pixel), sorted.
+    entries: Vec<(u32, u32)>,
+    /// Bucket b's pixels are entries[starts[b]..starts[b + 1]].
+    starts: Vec<u32>,
+    pixels: Vec<u32>,
+}
+
+impl Grid {
+    fn build(&mut self, pixels: &[PixelState]) {
+        let (mut lo, mut hi, mut r_max, mut count) = (
+            Vec3::splat(f64::INFINITY),
+            Vec3::splat(f64::NEG_INFINITY),
+            0.0f64,
+            0usize,
+        );
+        for px in pixels {
+            if let Some(vp) = &px.vp {
+                lo = lo.min(vp.p);
+                hi = hi.max(vp.p);
+                r_max = r_max.max(px.radius);
+                count += 1;
+            }
+        }
+        let buckets = count.next_power_of_two().max(1);
+        self.origin = lo;
+        // Cells as wide as the widest gather disc: a point overlaps at most 2 per axis.
+        self.cell = (2.0 * r_max).max(1e-9 * (hi - lo).max_component().max(1.0));
+        let (origin, cell, mask) = (self.origin, self.cell, buckets as u32 - 1);
+        self.entries.clear();
+        self.entries.par_extend(
+            pixels
+                .par_iter()
+                .enumerate()
+                .filter_map(|(i, px)| px.vp.as_ref().map(|vp| (i, vp.p, px.radius)))
+                .flat_map_iter(move |(i, p, r)| {
+                    let a = cell_of(p - Vec3::splat(r), origin, cell);
+                    let b = cell_of(p + Vec3::splat(r), origin, cell);
+                    (a[0]..=b[0]).flat_map(move |x| {
+                        (a[1]..=b[1]).flat_map(move |y| {
+                            (a[2]..=b[2]).map(move |z| (hash([x, y, z]) & mask, i as u32))
+                        })
+                    })
+                }),
+        );
+        self.entries.par_sort_unstable();
+        // Two cells of one point may share a bucket: it must gather a photon once.
+        self.entries.dedup();
+        self.starts.clear();
+        self.starts.resize(buckets + 1, 0);
+        for &(b, _) in &self.entries {
+            self.starts[b as usize + 1] += 1;
+        }
+        for b in 0..buckets {
+            self.starts[b + 1] += self.starts[b];
+        }
+        self.pixels.clear();
+        self.pixels.extend(self.entries.iter().map(|e| e.1));
+    }
+
+    /// The pixels whose visible points may lie within their radius of `p`.
+    fn near(&self, p: Vec3) -> &[u32] {
+        if self.pixels.is_empty() {
+            return &[];
+        }
+        let mask = self.starts.len() as u32 - 2;
+        let b = (hash(cell_of(p, self.origin, self.cell)) & mask) as usize;
+        &self.pixels[self.starts[b] as usize..self.starts[b + 1] as usize]
+    }
+}
+
+fn cell_of(p: Vec3, origin: Vec3, cell: f64) -> [i64; 3] {
+    let q = (p - origin) / cell;
+    [q.x.floor() as i64, q.y.floor() as i64, q.z.floor() as i64]
+}
+
+fn hash(c: [i64; 3]) -> u32 {
+    let h = (c[0].wrapping_mul(73_856_093))
+        ^ (c[1].wrapping_mul(19_349_663))
+        ^ (c[2].wrapping_mul(83_492_791));
+    (h as u64 ^ (h as u64 >> 32)) as u32
+}

@@ -1,0 +1,422 @@
+//! Photon mapping and stochastic progressive photon mapping against closed forms and an
+//! independent renderer: pbrt-v4's analytic furnace scenes (every pixel's radiance is 1),
+//! Mitsuba 3's converged Cornell box, the same image for any thread count, and clear errors
+//! for bad settings.
+
+mod common;
+use common::integrators::{cbox_reference, furnace, load_cornell_box, mean, read_exr, scene};
+
+use plenum_core::integrator::{ColorMode, IntegratorConfig, IntegratorKind, PhotonConfig};
+use plenum_core::render::{render, RenderSettings};
+use plenum_core::sampling::{PixelSampler, SamplerKind};
+use plenum_scene::{parse_scene, LoadedScene};
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+/// pbrt-v4's furnace (see common::integrators) on 16×16 pixels.
+fn furnace16(light: &str, sphere_emission: &str) -> String {
+    furnace(light, sphere_emission).replace("resolution = [12, 12]", "resolution = [16, 16]")
+}
+
+fn settings(
+    l: &LoadedScene,
+    kind: IntegratorKind,
+    spp: u32,
+    color: ColorMode,
+    photon: PhotonConfig,
+    seed: u64,
+) -> RenderSettings {
+    RenderSettings {
+        width: l.defaults.width,
+        height: l.defaults.height,
+        sampler: PixelSampler::new(SamplerKind::Random, spp),
+        integrator: IntegratorConfig {
+            kind,
+            max_depth: l.defaults.max_depth,
+            rr_depth: l.defaults.rr_depth,
+            color,
+            photon,
+            ..Default::default()
+        },
+        seed,
+        ..Default::default()
+    }
+}
+
+fn draw(l: &LoadedScene, settings: &RenderSettings) -> Vec<[f32; 3]> {
+    let out = render(&l.scene, settings, &AtomicBool::new(false), &|_, _| {});
+    assert_eq!(
+        out.counts.invalid, 0,
+        "no sample may come out NaN or infinite"
+    );
+    assert!(out.counts.photon > 0, "photons were traced");
+    out.film.pixels().to_vec()
+}
+
+/// The three furnaces: a central point light of intensity π, four of π/4, the sphere's own
+/// emission 0.5.
+fn furnaces() -> Vec<(&'static str, String)> {
+    let pi = std::f64::consts::PI;
+    let quarter = pi / 4.0;
+    let four: String = [
+        [0.1, 0.0, 0.0],
+        [-0.1, 0.0, 0.0],
+        [0.0, 0.1, 0.0],
+        [0.0, -0.1, 0.0],
+    ]
+    .iter()
+    .map(|p| format!("[[lights]]\ntype = \"point\"\nposition = {p:?}\nintensity = {quarter}\n"))
+    .collect();
+    vec![
+        (
+            "a central point light of intensity π",
+            furnace16(
+                &format!("[[lights]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = {pi}"),
+                "",
+            ),
+        ),
+        ("four point lights of intensity π/4", furnace16(&four, "")),
+        (
+            "the sphere's own emission 0.5",
+            furnace16("", "emission = [0.5, 0.5, 0.5]"),
+        ),
+    ]
+}
+
+/// Photon mapping in the furnaces: L = 1 everywhere. With 50,000 global photon paths, k = 64
+/// and 16 spp (seed 3) the image means came out within 0.009 of 1 (the density estimate is
+/// unbiased for light spread evenly over a sphere, as here, so what is left is noise and the
+/// spectral read-back of RGB photon flux); the test allows ±0.02.
+#[test]
+fn photon_mapping_furnaces_converge_to_radiance_one() {
+    for (what, text) in furnaces() {
+        let l = scene(&text);
+        for color in [ColorMode::Rgb, ColorMode::Spectral] {
+            let p = PhotonConfig {
+                photons: 50_000,
+                caustic_photons: 0,
+                ..Default::default()
+            };
+            let s = settings(&l, IntegratorKind::Photon, 16, color, p, 3);
+            let m = mean(&draw(&l, &s));
+            for (c, v) in m.iter().enumerate() {
+                assert!(
+                    (v - 1.0).abs() <= 0.02,
+                    "{what}, {color:?}: channel {c} has mean {v}, expected 1 ± 0.02"
+                );
+            }
+        }
+    }
+}
+
+/// The same photon-mapped image, bit for bit, on 1 and 3 threads (the photon pass's chunks,
+/// the kd-tree's parallel build and the tiles all run differently), in both colour modes.
+#[test]
+fn photon_mapped_image_does_not_depend_on_thread_count() {
+    let l = scene(&furnace16(
+        "[[lights]]\ntype = \"point\"\nposition = [0.2, 0.1, 0]\nintensity = 3",
+        "",
+    ));
+    for color in [ColorMode::Rgb, ColorMode::Spectral] {
+        let p = PhotonConfig {
+            photons: 40_000,
+            caustic_photons: 5_000,
+            ..Default::default()
+        };
+        let s = settings(&l, IntegratorKind::Photon, 2, color, p, 9);
+        let films: Vec<Vec<[f32; 3]>> = [1, 3]
+            .iter()
+            .map(|&n| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .unwrap()
+                    .install(|| draw(&l, &s))
+            })
+            .collect();
+        assert_eq!(films[0], films[1], "{color:?}");
+    }
+}
+
+/// Per channel, the image mean's relative error against the reference's mean, and the
+/// mean over pixels of |pixel − reference| / reference.
+fn relative_errors(image: &[[f32; 3]], reference: &[[f32; 3]]) -> ([f64; 3], f64) {
+    let (m, r) = (mean(image), mean(reference));
+    let means = [0, 1, 2].map(|c| m[c] / r[c] - 1.0);
+    let (mut sum, mut n) = (0.0, 0usize);
+    for (p, q) in image.iter().zip(reference) {
+        for c in 0..3 {
+            if q[c] > 1e-3 {
+                sum += ((p[c] - q[c]) / q[c]).abs() as f64;
+                n += 1;
+            }
+        }
+    }
+    (means, sum / n as f64)
+}
+
+/// The image cut into 8×8 blocks of 32×32 pixels: per block and channel, the block mean's
+/// relative error against the reference's; the largest of them.
+fn worst_block_error(image: &[[f32; 3]], reference: &[[f32; 3]], width: usize) -> f64 {
+    let blocks = width / 32;
+    let mut worst: f64 = 0.0;
+    for by in 0..blocks {
+        for bx in 0..blocks {
+            let (mut a, mut b) = ([0.0f64; 3], [0.0f64; 3]);
+            for y in by * 32..(by + 1) * 32 {
+                for x in bx * 32..(bx + 1) * 32 {
+                    for c in 0..3 {
+                        a[c] += image[y * width + x][c] as f64;
+                        b[c] += reference[y * width + x][c] as f64;
+                    }
+                }
+            }
+            for c in 0..3 {
+                if b[c] > 1e-3 * 1024.0 {
+                    worst = worst.max((a[c] / b[c] - 1.0).abs());
+                }
+            }
+        }
+    }
+    worst
+}
+
+/// Photon mapping on the Cornell box, defaults (200,000 global and caustic photon paths,
+/// k = 64, one gather ray), 4 spp, seed 1: measured, the image mean is 0.1–0.8 % low per
+/// channel in RGB and spectrally (at 32 spp: 0.4–0.8 % low; the worst 32×32-pixel block 6–7 %
+/// off, in the corners, where density estimation blurs light across the edge). The test
+/// allows ±1.5 % on each channel's mean.
+#[test]
+fn photon_mapping_cornell_box_mean_matches_mitsuba() {
+    let l = load_cornell_box();
+    for (color, file) in [
+        (ColorMode::Rgb, "reference.exr"),
+        (ColorMode::Spectral, "reference-spectral.exr"),
+    ] {
+        let Some(r) = cbox_reference(file) else {
+            eprintln!("../shared/data/references/cbox is not here: nothing to compare with");
+            return;
+        };
+        let reference = read_exr(&r);
+        let s = settings(
+            &l,
+            IntegratorKind::Photon,
+            4,
+            color,
+            PhotonConfig::default(),
+            1,
+        );
+        let image = draw(&l, &s);
+        let (means, pixel_error) = relative_errors(&image, &reference);
+        let blocks = worst_block_error(&image, &reference, 256);
+        eprintln!("photon, {color:?}: mean error per channel {means:?}, mean per-pixel relative error {pixel_error:.3}, worst block {blocks:.3}");
+        for (c, e) in means.iter().enumerate() {
+            assert!(
+                e.abs() <= 0.015,
+                "{color:?}: channel {c} mean is off by {e}"
+            );
+        }
+    }
+}
+
+/// SPPM in the furnaces: L = 1 everywhere. 64 iterations of 20,000 photon paths, seed 3:
+/// the image means came out within 0.009 of 1 (RGB within 0.004); the test asks ±0.01.
+fn sppm_furnaces(color: ColorMode) {
+    for (what, text) in furnaces() {
+        let l = scene(&text);
+        let p = PhotonConfig {
+            sppm_photons: 20_000,
+            ..Default::default()
+        };
+        let m = mean(&draw(
+            &l,
+            &settings(&l, IntegratorKind::Sppm, 64, color, p, 3),
+        ));
+        for (c, v) in m.iter().enumerate() {
+            assert!(
+                (v - 1.0).abs() <= 0.01,
+                "{what}, {color:?}: channel {c} has mean {v}, expected 1 ± 0.01"
+            );
+        }
+    }
+}
+
+#[test]
+fn sppm_furnaces_converge_to_radiance_one_in_rgb() {
+    sppm_furnaces(ColorMode::Rgb);
+}
+
+#[test]
+fn sppm_furnaces_converge_to_radiance_one_spectrally() {
+    sppm_furnaces(ColorMode::Spectral);
+}
+
+/// The same SPPM image, bit for bit, on 1 and 3 threads, in both colour modes.
+#[test]
+fn sppm_image_does_not_depend_on_thread_count() {
+    let l = scene(&furnace16(
+        "[[lights]]\ntype = \"point\"\nposition = [0.2, 0.1, 0]\nintensity = 3",
+        "",
+    ));
+    for color in [ColorMode::Rgb, ColorMode::Spectral] {
+        let p = PhotonConfig {
+            sppm_photons: 10_000,
+            ..Default::default()
+        };
+        let s = settings(&l, IntegratorKind::Sppm, 4, color, p, 9);
+        let films: Vec<Vec<[f32; 3]>> = [1, 3]
+            .iter()
+            .map(|&n| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .unwrap()
+                    .install(|| draw(&l, &s))
+            })
+            .collect();
+        assert_eq!(films[0], films[1], "{color:?}");
+    }
+}
+
+/// SPPM on the Cornell box, 32 iterations of 65,536 photon paths (the pixel count), seed 1.
+/// A z-test against the reference needs independent renders whose spread measures the
+/// noise; 16 of them cost minutes, and SPPM's bias at so few iterations (light blurred over
+/// the radius at edges and in corners) is not yet below the reference's noise. What it
+/// achieves, measured: each channel's image mean within 0.21 % (RGB and spectral), the mean
+/// per-pixel relative error 0.10 (RGB) and 0.12 (spectral; 0.08 at 64 iterations), every
+/// 32×32-pixel block's mean within 4.4 % (2.9 % at 64 iterations). The
+/// test asks: each channel's mean within ±1 %, every block within ±6 %, the mean per-pixel
+/// relative error below 0.15, in RGB and spectrally.
+#[test]
+fn sppm_cornell_box_matches_mitsuba() {
+    let l = load_cornell_box();
+    for (color, file) in [
+        (ColorMode::Rgb, "reference.exr"),
+        (ColorMode::Spectral, "reference-spectral.exr"),
+    ] {
+        let Some(r) = cbox_reference(file) else {
+            eprintln!("../shared/data/references/cbox is not here: nothing to compare with");
+            return;
+        };
+        let reference = read_exr(&r);
+        let s = settings(
+            &l,
+            IntegratorKind::Sppm,
+            32,
+            color,
+            PhotonConfig::default(),
+            1,
+        );
+        let image = draw(&l, &s);
+        let (means, pixel_error) = relative_errors(&image, &reference);
+        let blocks = worst_block_error(&image, &reference, 256);
+        eprintln!("sppm, {color:?}: mean error per channel {means:?}, mean per-pixel relative error {pixel_error:.3}, worst block {blocks:.3}");
+        for (c, e) in means.iter().enumerate() {
+            assert!(e.abs() <= 0.01, "{color:?}: channel {c} mean is off by {e}");
+        }
+        assert!(blocks <= 0.06, "{color:?}: a block is off by {blocks}");
+        assert!(
+            pixel_error <= 0.15,
+            "{color:?}: per-pixel error {pixel_error}"
+        );
+    }
+}
+
+/// Bad photon settings are refused with a reason, by the render settings' check and by the
+/// scene format (at the key).
+#[test]
+fn bad_photon_settings_give_clear_errors() {
+    let l = scene(&furnace16("", "emission = [0.5, 0.5, 0.5]"));
+    let base = PhotonConfig::default();
+    for (bad, says) in [
+        (PhotonConfig { photons: 0, ..base }, "photons"),
+        (PhotonConfig { nearest: 0, ..base }, "density estimate"),
+        (
+            PhotonConfig {
+                nearest: 100_000,
+                ..base
+            },
+            "density estimate",
+        ),
+        (
+            PhotonConfig {
+                radius: -1.0,
+                ..base
+            },
+            "radius",
+        ),
+        (
+            PhotonConfig {
+                radius: f64::NAN,
+                ..base
+            },
+            "radius",
+        ),
+        (
+            PhotonConfig {
+                gather_rays: 0,
+                ..base
+            },
+            "final-gather",
+        ),
+        (PhotonConfig { alpha: 1.0, ..base }, "alpha"),
+        (PhotonConfig { alpha: 0.0, ..base }, "alpha"),
+    ] {
+        for kind in [IntegratorKind::Photon, IntegratorKind::Sppm] {
+            let s = settings(&l, kind, 1, ColorMode::Rgb, bad, 0);
+            let e = s.check().expect_err("bad settings are refused");
+            assert!(e.contains(says), "{bad:?}: {e}");
+        }
+        // The path tracer does not read them.
+        assert!(
+            settings(&l, IntegratorKind::Path, 1, ColorMode::Rgb, bad, 0)
+                .check()
+                .is_ok()
+        );
+    }
+    let mut s = settings(&l, IntegratorKind::Sppm, 4, ColorMode::Rgb, base, 0);
+    s.filter = plenum_core::sampling::Filter::new(plenum_core::sampling::FilterKind::Gaussian, 1.5)
+        .unwrap();
+    assert!(s.check().unwrap_err().contains("box filter"));
+
+    for (key, value) in [
+        ("photons", "0"),
+        ("photon_nearest", "0"),
+        ("photon_radius", "-2"),
+        ("gather_rays", "0"),
+        ("sppm_alpha", "1.5"),
+        ("caustic_photons", "-1"),
+    ] {
+        let text =
+            furnace16("", "").replace("rr_depth = 5", &format!("rr_depth = 5\n{key} = {value}"));
+        let e = parse_scene(Path::new("bad.toml"), &text, Path::new("."))
+            .err()
+            .unwrap_or_else(|| panic!("{key} = {value} is refused"))
+            .to_string();
+        assert!(
+            e.contains("bad.toml:5:"),
+            "{key} = {value}: the error points at it: {e}"
+        );
+    }
+    let good = furnace16("", "").replace(
+        "rr_depth = 5",
+        "rr_depth = 5\nphotons = 1000\ncaustic_photons = 0\nphoton_nearest = 10\nphoton_radius = 0.5\ngather_rays = 4\nsppm_photons = 77\nsppm_alpha = 0.5",
+    );
+    let d = scene(&good).defaults.photon;
+    assert_eq!(
+        d,
+        PhotonConfig {
+            photons: 1000,
+            caustic_photons: 0,
+            nearest: 10,
+            radius: 0.5,
+            gather_rays: 4,
+            sppm_photons: 77,
+            alpha: 0.5,
+        }
+    );
+    // The writer keeps them.
+    let l = scene(&good);
+    let back = scene(&plenum_scene::to_toml(&l.scene, &l.defaults));
+    assert_eq!(back.defaults.photon, d);
+}
