@@ -86,9 +86,8 @@ fn bdpt_matches_mitsuba_on_the_cornell_box() {
 
 /// A floor whose shading normals lean 35° away from its true normal, lit by a small area
 /// light: light carried from the light (light tracing, BDPT's light subpaths) scatters by
-/// the adjoint BSDF with Veach's correction, so all three methods see the same floor. Without
-/// the correction light tracing is 25 % off here. Means over 20×16 pixels at 256 spp agree
-/// within 1.5 % (seed 5; the standard errors are below 0.4 %).
+/// the adjoint BSDF with Veach's correction, so all three methods see the same floor. Means
+/// over 20×16 pixels at 256 spp agree within 1.5 % (seed 5).
 #[test]
 fn light_from_the_lights_and_from_the_camera_agree_on_shading_normals() {
     let l = scene(

@@ -87,6 +87,11 @@ impl Complex {
 
 /// Reflectance of one lane at a conductor of complex relative index η + ik.
 fn fr_complex_lane(cos_i: f64, eta: f64, k: f64) -> f64 {
+    // An index of exactly 0 is no material: the unused fourth lane in RGB mode. It
+    // reflects nothing (the formula would divide 0 by 0).
+    if eta == 0.0 && k == 0.0 {
+        return 0.0;
+    }
     let cos_i = cos_i.clamp(0.0, 1.0);
     let eta = Complex::new(eta, k);
     let sin2_i = Complex::real(1.0 - cos_i * cos_i);
@@ -111,6 +116,16 @@ pub fn fr_complex(cos_i: f64, eta: SampledSpectrum, k: SampledSpectrum) -> Sampl
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// In RGB mode a conductor's fourth lane has η = k = 0: finite, and nothing reflected.
+    #[test]
+    fn the_unused_rgb_lane_stays_finite() {
+        let eta = SampledSpectrum([0.16, 0.14, 0.13, 0.0]);
+        let k = SampledSpectrum([3.9, 3.0, 2.4, 0.0]);
+        let r = fr_complex(0.7, eta, k);
+        assert!(r.is_finite(), "{r:?}");
+        assert_eq!(r[3], 0.0);
+    }
 
     #[test]
     fn dielectric_at_80_degrees() {
