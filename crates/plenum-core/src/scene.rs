@@ -479,6 +479,18 @@ impl Scene {
         };
     }
 
+    /// The centre of everything bounded (the origin for an empty scene) and the radius of a
+    /// sphere about it: where light from infinity enters the scene.
+    pub fn bounding_sphere(&self) -> (Vec3, f64) {
+        let b = self.bounds();
+        let center = if b.min.x.is_finite() && b.max.x.is_finite() {
+            (b.min + b.max) * 0.5
+        } else {
+            Vec3::ZERO
+        };
+        (center, self.scene_radius())
+    }
+
     /// The radius of a sphere about everything bounded (1 for an empty scene).
     pub fn scene_radius(&self) -> f64 {
         let b = self.bounds();

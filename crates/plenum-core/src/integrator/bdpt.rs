@@ -19,7 +19,7 @@
 //! correction (§5.3, [`super::light_tracing`]); emission that no light represents (the
 //! background, a Phong material's k_e) is found by s = 0 alone and so takes weight 1.
 
-use super::light_tracing::{adjoint_cosine_of, emitted_spectrum, leave_light, rgb};
+use super::light_tracing::{adjoint_cosine_of, leave_light, rgb, start_light_path, LightStart};
 use super::{IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Strategy};
 use crate::accel::Coherence;
 use crate::bxdf::{Bsdf, TransportMode};
@@ -223,12 +223,7 @@ impl<'a> BidirectionalPathTracer<'a> {
         splats: &'a SplatBuffer,
         strategies: Option<&'a StrategyImages>,
     ) -> Self {
-        let b = scene.bounds();
-        let center = if b.min.x.is_finite() && b.max.x.is_finite() {
-            (b.min + b.max) * 0.5
-        } else {
-            Vec3::ZERO
-        };
+        let (center, radius) = scene.bounding_sphere();
         BidirectionalPathTracer {
             scene,
             camera,
@@ -238,7 +233,7 @@ impl<'a> BidirectionalPathTracer<'a> {
             rr_depth: config.rr_depth,
             color: config.color,
             center,
-            radius: scene.scene_radius(),
+            radius,
         }
     }
 
@@ -265,10 +260,7 @@ impl<'a> BidirectionalPathTracer<'a> {
         scratch: &mut Scratch,
     ) -> Color {
         counts.camera += 1;
-        let mut wl = match self.color {
-            ColorMode::Spectral => SampledWavelengths::sample_visible(stream.next_1d()),
-            ColorMode::Rgb => SampledWavelengths::rgb(),
-        };
+        let mut wl = super::sample_wavelengths(self.color, stream);
         let Scratch {
             camera: camera_path,
             light: light_path,
@@ -405,19 +397,17 @@ impl<'a> BidirectionalPathTracer<'a> {
         path: &mut Vec<Vertex>,
     ) {
         let scene = self.scene;
-        let ul = stream.next_1d();
-        let (u_pos, u_dir) = (stream.next_2d(), stream.next_2d());
-        let Some((index, pmf)) = scene.light_sampler.sample(ul) else {
+        let Some(LightStart {
+            index,
+            pmf,
+            es,
+            le,
+            beta,
+        }) = start_light_path(scene, (self.center, self.radius), wl, stream)
+        else {
             return;
         };
         let light = &scene.lights[index as usize];
-        let Some(es) = light.sample_le(u_pos, u_dir, self.center, self.radius) else {
-            return;
-        };
-        let le = emitted_spectrum(scene, index, &es, wl);
-        if le.is_black() || es.pdf.pos == 0.0 || es.pdf.dir == 0.0 {
-            return;
-        }
         let mut v = Vertex::endpoint(Kind::Light, es.ray.origin, le);
         v.light = Some(index);
         if let Some(n) = es.n {
@@ -432,8 +422,6 @@ impl<'a> BidirectionalPathTracer<'a> {
             v.pdf_fwd = pmf * es.pdf.pos;
         }
         path.push(v);
-        let cos = es.n.map_or(1.0, |n| n.dot(es.ray.direction).abs());
-        let beta = le * (cos / (pmf * es.pdf.pos * es.pdf.dir));
         let ray = leave_light(&es).at_time(time);
         self.random_walk(
             ray,

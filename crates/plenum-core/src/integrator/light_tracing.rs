@@ -48,12 +48,7 @@ impl<'a> LightTracer<'a> {
         camera: &'a Camera,
         splats: &'a SplatBuffer,
     ) -> Self {
-        let b = scene.bounds();
-        let center = if b.min.x.is_finite() && b.max.x.is_finite() {
-            (b.min + b.max) * 0.5
-        } else {
-            Vec3::ZERO
-        };
+        let (center, radius) = scene.bounding_sphere();
         LightTracer {
             scene,
             camera,
@@ -62,7 +57,7 @@ impl<'a> LightTracer<'a> {
             rr_depth: config.rr_depth,
             color: config.color,
             center,
-            radius: scene.scene_radius(),
+            radius,
         }
     }
 
@@ -75,10 +70,7 @@ impl<'a> LightTracer<'a> {
         counts: &mut RayCounts,
         tree: Option<&mut RayTree>,
     ) -> Color {
-        let mut wl = match self.color {
-            ColorMode::Spectral => SampledWavelengths::sample_visible(stream.next_1d()),
-            ColorMode::Rgb => SampledWavelengths::rgb(),
-        };
+        let mut wl = super::sample_wavelengths(self.color, stream);
         self.light_path(ray.time, &mut wl, stream, counts, tree);
         Color::BLACK
     }
@@ -92,25 +84,17 @@ impl<'a> LightTracer<'a> {
         mut tree: Option<&mut RayTree>,
     ) {
         let scene = self.scene;
-        let ul = stream.next_1d();
-        let (u_pos, u_dir, u_lens) = (stream.next_2d(), stream.next_2d(), stream.next_2d());
-        let Some((index, pmf)) = scene.light_sampler.sample(ul) else {
+        let Some(start) = start_light_path(scene, (self.center, self.radius), wl, stream) else {
             return;
         };
+        let LightStart { index, pmf, es, .. } = start;
         let light = &scene.lights[index as usize];
-        let Some(es) = light.sample_le(u_pos, u_dir, self.center, self.radius) else {
-            return;
-        };
-        let le = emitted_spectrum(scene, index, &es, wl);
-        if le.is_black() {
-            return;
-        }
         // The light's own point, seen by the camera.
+        let u_lens = stream.next_2d();
         if let Some(l) = self.light_to_camera(light, index, &es, pmf, u_lens, time, wl, counts) {
             self.splat(l.0, l.1, wl, counts);
         }
-        let cos = es.n.map_or(1.0, |n| n.dot(es.ray.direction).abs());
-        let mut beta = le * (cos / (pmf * es.pdf.pos * es.pdf.dir));
+        let mut beta = start.beta;
         let mut ray = leave_light(&es).at_time(time);
         let mut parent = None;
         for depth in 0..=self.max_depth {
@@ -232,6 +216,44 @@ impl<'a> LightTracer<'a> {
         }
         self.splats.add(raster, c);
     }
+}
+
+/// The start of a light path: a light chosen by power, a ray leaving it, the light the ray
+/// carries, and the path's throughput over its first segment, Le·|cos θ| / (p_light·p_pos·p_dir).
+pub(super) struct LightStart {
+    pub index: u32,
+    pub pmf: f64,
+    pub es: EmissionSample,
+    pub le: SampledSpectrum,
+    pub beta: SampledSpectrum,
+}
+
+/// Draws a [`LightStart`] from three of the stream's dimensions (light, position,
+/// direction), in the scene's bounding sphere (`center`, `radius`); `None` if it carries
+/// nothing.
+pub(super) fn start_light_path(
+    scene: &Scene,
+    (center, radius): (Vec3, f64),
+    wl: &SampledWavelengths,
+    stream: &mut SampleStream,
+) -> Option<LightStart> {
+    let ul = stream.next_1d();
+    let (u_pos, u_dir) = (stream.next_2d(), stream.next_2d());
+    let (index, pmf) = scene.light_sampler.sample(ul)?;
+    let es = scene.lights[index as usize].sample_le(u_pos, u_dir, center, radius)?;
+    let le = emitted_spectrum(scene, index, &es, wl);
+    if le.is_black() || es.pdf.pos == 0.0 || es.pdf.dir == 0.0 {
+        return None;
+    }
+    let cos = es.n.map_or(1.0, |n| n.dot(es.ray.direction).abs());
+    let beta = le * (cos / (pmf * es.pdf.pos * es.pdf.dir));
+    Some(LightStart {
+        index,
+        pmf,
+        es,
+        le,
+        beta,
+    })
 }
 
 /// The light a sampled emission ray carries: the light's spectrum times its falloff, or an

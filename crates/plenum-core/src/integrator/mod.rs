@@ -30,6 +30,7 @@ use crate::math::Ray;
 use crate::sampling::SampleStream;
 use crate::scene::Scene;
 pub use plenum_spectrum::ColorMode;
+use plenum_spectrum::SampledWavelengths;
 
 /// The methods a scene can be rendered with: the lecture's ladder, from local illumination
 /// to bidirectional path tracing.
@@ -218,6 +219,18 @@ impl IntegratorConfig {
             min_weight: self.min_weight,
             shadows: self.kind != IntegratorKind::Local,
         }
+    }
+}
+
+/// A sample's wavelengths: drawn from the stream's next number in spectral mode (so the
+/// sampler stratifies them across a pixel's samples), the RGB lanes otherwise.
+pub(crate) fn sample_wavelengths(
+    color: ColorMode,
+    stream: &mut SampleStream,
+) -> SampledWavelengths {
+    match color {
+        ColorMode::Spectral => SampledWavelengths::sample_visible(stream.next_1d()),
+        ColorMode::Rgb => SampledWavelengths::rgb(),
     }
 }
 

@@ -62,10 +62,7 @@ impl<'a> PathTracer<'a> {
         tree: Option<&mut RayTree>,
     ) -> Color {
         counts.camera += 1;
-        let mut wl = match self.color {
-            ColorMode::Spectral => SampledWavelengths::sample_visible(stream.next_1d()),
-            ColorMode::Rgb => SampledWavelengths::rgb(),
-        };
+        let mut wl = super::sample_wavelengths(self.color, stream);
         let l = self.li(ray, &mut wl, stream, counts, tree);
         if !l.is_finite() {
             counts.invalid += 1;

@@ -107,10 +107,7 @@ impl<'a> PhotonMapper<'a> {
         tree: Option<&mut RayTree>,
     ) -> Color {
         counts.camera += 1;
-        let mut wl = match self.color {
-            ColorMode::Spectral => SampledWavelengths::sample_visible(stream.next_1d()),
-            ColorMode::Rgb => SampledWavelengths::rgb(),
-        };
+        let mut wl = super::sample_wavelengths(self.color, stream);
         let l = self.li(ray, &mut wl, stream, counts, tree);
         let c = rgb(l, &wl);
         if !(l.is_finite() && c.r.is_finite() && c.g.is_finite() && c.b.is_finite()) {
@@ -350,10 +347,7 @@ fn photon_pass(
             let mut counts = RayCounts::default();
             for i in c * CHUNK..((c + 1) * CHUNK).min(paths) {
                 let mut stream = PhotonTracer::stream(seed, pass, i);
-                let mut wl = match color {
-                    ColorMode::Spectral => SampledWavelengths::sample_visible(stream.next_1d()),
-                    ColorMode::Rgb => SampledWavelengths::rgb(),
-                };
+                let mut wl = super::sample_wavelengths(color, &mut stream);
                 let time = camera.time(stream.next_1d());
                 tracer.trace(time, &mut wl, &mut stream, &mut counts, |a, wl| {
                     if caustic && !a.caustic {

@@ -13,7 +13,7 @@
 //! so the photon methods use a photon at an eye vertex only where d ≤ `max_depth` + 2 − e,
 //! and render the same paths as the path tracer.
 
-use super::light_tracing::{adjoint_cosine, emitted_spectrum, leave_light};
+use super::light_tracing::{adjoint_cosine, leave_light, start_light_path};
 use super::{IntegratorConfig, RayCounts};
 use crate::accel::Coherence;
 use crate::bxdf::{Bsdf, TransportMode};
@@ -47,18 +47,13 @@ pub(super) struct PhotonTracer<'a> {
 
 impl<'a> PhotonTracer<'a> {
     pub fn new(scene: &'a Scene, config: &IntegratorConfig) -> Self {
-        let b = scene.bounds();
-        let center = if b.min.x.is_finite() && b.max.x.is_finite() {
-            (b.min + b.max) * 0.5
-        } else {
-            Vec3::ZERO
-        };
+        let (center, radius) = scene.bounding_sphere();
         PhotonTracer {
             scene,
             max_depth: config.max_depth,
             rr_depth: config.rr_depth,
             center,
-            radius: scene.scene_radius(),
+            radius,
         }
     }
 
@@ -85,22 +80,11 @@ impl<'a> PhotonTracer<'a> {
         mut arrive: impl FnMut(&Arrival, &SampledWavelengths) -> bool,
     ) {
         let scene = self.scene;
-        let ul = stream.next_1d();
-        let (u_pos, u_dir) = (stream.next_2d(), stream.next_2d());
-        let Some((index, pmf)) = scene.light_sampler.sample(ul) else {
+        let Some(start) = start_light_path(scene, (self.center, self.radius), wl, stream) else {
             return;
         };
-        let light = &scene.lights[index as usize];
-        let Some(es) = light.sample_le(u_pos, u_dir, self.center, self.radius) else {
-            return;
-        };
-        let le = emitted_spectrum(scene, index, &es, wl);
-        if le.is_black() || es.pdf.pos == 0.0 || es.pdf.dir == 0.0 {
-            return;
-        }
-        let cos = es.n.map_or(1.0, |n| n.dot(es.ray.direction).abs());
-        let mut beta = le * (cos / (pmf * es.pdf.pos * es.pdf.dir));
-        let mut ray = leave_light(&es).at_time(time);
+        let mut beta = start.beta;
+        let mut ray = leave_light(&start.es).at_time(time);
         let mut specular_only = true;
         for depth in 1..=self.max_depth + 1 {
             counts.photon += 1;
