@@ -16,7 +16,7 @@
 //!
 //! Shading normals: light carried from the lights scatters by the adjoint BSDF with Veach's
 //! correction (thesis §5.3), f*(ωo, ωi) = f(ωo, ωi)·|ωo·n_s||ωi·n_g| / (|ωo·n_g||ωi·n_s|),
-//! so smooth-shaded and bump-mapped surfaces receive the light a camera path would find.
+//! so smooth-shaded surfaces receive the light a camera path would find.
 
 use super::{IntegratorConfig, RayCounts, RayKind, RayNode, RayTree};
 use crate::accel::Coherence;
