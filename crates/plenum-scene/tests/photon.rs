@@ -4,14 +4,15 @@
 //! for bad settings.
 
 mod common;
-use common::integrators::{cbox_reference, furnace, load_cornell_box, mean, read_exr, scene};
+use common::integrators::{
+    cbox_reference, furnace, furnace_cases, load_cornell_box, mean, read_exr, render_checked,
+    scene, settings_for,
+};
 
-use plenum_core::integrator::{ColorMode, IntegratorConfig, IntegratorKind, PhotonConfig};
-use plenum_core::render::{render, RenderSettings};
-use plenum_core::sampling::{PixelSampler, SamplerKind};
+use plenum_core::integrator::{ColorMode, IntegratorKind, PhotonConfig};
+use plenum_core::render::RenderSettings;
 use plenum_scene::{parse_scene, LoadedScene};
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
 
 /// pbrt-v4's furnace (see common::integrators) on 16×16 pixels.
 fn furnace16(light: &str, sphere_emission: &str) -> String {
@@ -26,61 +27,23 @@ fn settings(
     photon: PhotonConfig,
     seed: u64,
 ) -> RenderSettings {
-    RenderSettings {
-        width: l.defaults.width,
-        height: l.defaults.height,
-        sampler: PixelSampler::new(SamplerKind::Random, spp),
-        integrator: IntegratorConfig {
-            kind,
-            max_depth: l.defaults.max_depth,
-            rr_depth: l.defaults.rr_depth,
-            color,
-            photon,
-            ..Default::default()
-        },
-        seed,
-        ..Default::default()
-    }
+    let mut s = settings_for(l, kind, spp, color, seed);
+    s.integrator.photon = photon;
+    s
 }
 
 fn draw(l: &LoadedScene, settings: &RenderSettings) -> Vec<[f32; 3]> {
-    let out = render(&l.scene, settings, &AtomicBool::new(false), &|_, _| {});
-    assert_eq!(
-        out.counts.invalid, 0,
-        "no sample may come out NaN or infinite"
-    );
+    let out = render_checked(l, settings);
     assert!(out.counts.photon > 0, "photons were traced");
     out.film.pixels().to_vec()
 }
 
-/// The three furnaces: a central point light of intensity π, four of π/4, the sphere's own
-/// emission 0.5.
+/// The three furnaces on 16×16 pixels.
 fn furnaces() -> Vec<(&'static str, String)> {
-    let pi = std::f64::consts::PI;
-    let quarter = pi / 4.0;
-    let four: String = [
-        [0.1, 0.0, 0.0],
-        [-0.1, 0.0, 0.0],
-        [0.0, 0.1, 0.0],
-        [0.0, -0.1, 0.0],
-    ]
-    .iter()
-    .map(|p| format!("[[lights]]\ntype = \"point\"\nposition = {p:?}\nintensity = {quarter}\n"))
-    .collect();
-    vec![
-        (
-            "a central point light of intensity π",
-            furnace16(
-                &format!("[[lights]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = {pi}"),
-                "",
-            ),
-        ),
-        ("four point lights of intensity π/4", furnace16(&four, "")),
-        (
-            "the sphere's own emission 0.5",
-            furnace16("", "emission = [0.5, 0.5, 0.5]"),
-        ),
-    ]
+    furnace_cases()
+        .into_iter()
+        .map(|(what, light, emission)| (what, furnace16(&light, &emission)))
+        .collect()
 }
 
 /// Photon mapping in the furnaces: L = 1 everywhere. With 50,000 global photon paths, k = 64

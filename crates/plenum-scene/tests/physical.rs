@@ -20,36 +20,7 @@ use common::integrators::*;
 /// (Russian roulette, unbiased; the standard error of the mean here is below 0.003).
 #[test]
 fn furnace_scenes_converge_to_radiance_one() {
-    let pi = std::f64::consts::PI;
-    let quarter = pi / 4.0;
-    let cases = [
-        (
-            "a central point light of intensity π",
-            format!("[[lights]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = {pi}"),
-            String::new(),
-        ),
-        (
-            "four point lights of intensity π/4",
-            [
-                [0.1, 0.0, 0.0],
-                [-0.1, 0.0, 0.0],
-                [0.0, 0.1, 0.0],
-                [0.0, -0.1, 0.0],
-            ]
-            .iter()
-            .map(|p| {
-                format!("[[lights]]\ntype = \"point\"\nposition = {p:?}\nintensity = {quarter}\n")
-            })
-            .collect(),
-            String::new(),
-        ),
-        (
-            "the sphere's own emission 0.5",
-            String::new(),
-            "emission = [0.5, 0.5, 0.5]".to_string(),
-        ),
-    ];
-    for (what, light, emission) in cases {
+    for (what, light, emission) in furnace_cases() {
         let l = scene(&furnace(&light, &emission));
         for color in [ColorMode::Rgb, ColorMode::Spectral] {
             let m = mean(&draw(&l, &path_settings(&l, 256, color, 3)));

@@ -30,7 +30,7 @@ use super::{
     same_hemisphere, BsdfSample, BxdfFlags, DielectricBxdf, DiffuseBxdf, SampleFlags, TransportMode,
 };
 use crate::math::Vec3;
-use crate::sampling::{Frame, Rng};
+use crate::sampling::{power_heuristic, Frame, Rng};
 
 #[derive(Clone, Copy, Debug)]
 pub struct CoatedDiffuseBxdf {
@@ -49,18 +49,6 @@ pub struct CoatedDiffuseBxdf {
     pub max_depth: u32,
     /// Walks per evaluation of `f`.
     pub samples: u32,
-}
-
-/// The power heuristic with exponent 2, one sample from each strategy.
-fn power_heuristic(f_pdf: f64, g_pdf: f64) -> f64 {
-    let (f2, g2) = (f_pdf * f_pdf, g_pdf * g_pdf);
-    if f2.is_infinite() {
-        1.0
-    } else if f2 + g2 == 0.0 {
-        0.0
-    } else {
-        f2 / (f2 + g2)
-    }
 }
 
 /// A 64-bit hash of several numbers (their bits, mixed by SplitMix64's finaliser).

@@ -5,6 +5,7 @@
 //! `ImageTileIntegrator`). The integrator is chosen once per render, and dispatched by `match`.
 
 mod bdpt;
+mod direct;
 mod light_tracing;
 mod medium;
 mod path;

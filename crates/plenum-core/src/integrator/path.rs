@@ -11,14 +11,12 @@
 //! into linear sRGB once at the end. A sample that comes out NaN or infinite is counted in
 //! [`RayCounts::invalid`] and left out of the film.
 
-use super::{IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Stop};
-use crate::accel::Coherence;
+use super::{direct, IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Stop};
 use crate::bxdf::TransportMode;
 use crate::color::Color;
-use crate::light::LightSample;
-use crate::math::{offset_ray_origin, Ray, Vec3};
+use crate::math::{offset_ray_origin, Ray};
 use crate::sampling::SampleStream;
-use crate::scene::{Interaction, Scene};
+use crate::scene::Scene;
 use plenum_spectrum::{ColorMode, SampledSpectrum, SampledWavelengths};
 
 pub struct PathTracer<'a> {
@@ -26,20 +24,6 @@ pub struct PathTracer<'a> {
     max_depth: u32,
     rr_depth: u32,
     color: ColorMode,
-}
-
-/// w_a for a sample of pdf `a` against one other strategy of pdf `b`, by the power
-/// heuristic (β = 2); written as a ratio so that huge pdfs do not overflow.
-#[inline]
-pub fn power_heuristic(a: f64, b: f64) -> f64 {
-    if a.is_infinite() {
-        return 1.0;
-    }
-    if a == 0.0 {
-        return 0.0;
-    }
-    let r = b / a;
-    1.0 / (1.0 + r * r)
 }
 
 impl<'a> PathTracer<'a> {
@@ -90,11 +74,10 @@ impl<'a> PathTracer<'a> {
         let scene = self.scene;
         let mut l = SampledSpectrum::ZERO;
         let mut beta = SampledSpectrum::ONE;
-        // The camera ray and specular bounces find emitters that light sampling cannot.
-        let mut specular_bounce = true;
         // For MIS on an emitter the path hits: the BSDF pdf of the direction it left by,
-        // and the point it left from.
-        let mut pdf_bsdf = 0.0;
+        // and the point it left from. The camera ray and specular bounces find emitters that
+        // light sampling cannot: their infinite pdf takes the emission in full.
+        let mut pdf_bsdf = f64::INFINITY;
         let mut previous = camera_ray.origin;
         // The product of η² over transmissions, which radiance scaling has divided out of
         // beta but which must not drive Russian roulette (pbrt-v4's `etaScale`).
@@ -116,7 +99,8 @@ impl<'a> PathTracer<'a> {
             });
             let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
                 let d = ray.direction.normalized();
-                let le = self.escaped(d, wl, specular_bounce, pdf_bsdf);
+                let le = scene.background_spectrum(wl)
+                    + direct::infinite_mis(scene, d, wl, pdf_bsdf, 1.0);
                 l += beta * le;
                 record(&mut tree, node, |n| {
                     n.stops.push(Stop::Miss);
@@ -141,7 +125,7 @@ impl<'a> PathTracer<'a> {
             // having found it.
             let before = l;
             if let Some(light) = scene.light_of(prim) {
-                let le = self.emitted(light, &it, wo, wl, specular_bounce, pdf_bsdf, previous);
+                let le = direct::emitted_mis(scene, light, &it, wo, wl, pdf_bsdf, previous, 1.0);
                 l += beta * le;
             } else if let Some(ke) = scene.phong_emission(&it, wl) {
                 // A Phong surface's k_e: seen, but no light to sample.
@@ -162,7 +146,10 @@ impl<'a> PathTracer<'a> {
             };
             let flags = bsdf.flags();
             if flags.is_non_specular() {
-                let ld = self.sample_light(&it, wo, &bsdf, wl, stream, counts, &ray);
+                // The light sample is weighed against the next bounce's, which the last
+                // vertex does not take.
+                let n = if depth < self.max_depth { 1.0 } else { 0.0 };
+                let ld = direct::sample_ld(scene, &it, wo, &bsdf, wl, stream, counts, ray.time, n);
                 l += beta * ld;
             }
             record(&mut tree, node, |n| n.color = added(l, wl));
@@ -179,12 +166,10 @@ impl<'a> PathTracer<'a> {
             };
             let cos = bs.wi.dot(it.shading_n).abs();
             beta *= bs.f * (cos / bs.pdf);
-            pdf_bsdf = if bs.pdf_is_proportional {
-                bsdf.pdf(wo, bs.wi, TransportMode::Radiance)
-            } else {
-                bs.pdf
+            pdf_bsdf = match bs.is_specular() {
+                true => f64::INFINITY,
+                false => direct::bsdf_pdf(&bsdf, wo, &bs),
             };
-            specular_bounce = bs.is_specular();
             if bs.is_transmission() {
                 eta_scale *= bs.eta * bs.eta;
                 counts.refraction += 1;
@@ -213,115 +198,6 @@ impl<'a> PathTracer<'a> {
             }
         }
         l
-    }
-
-    /// Radiance from an area light's surface toward `wo`, MIS-weighted unless the path
-    /// arrived by a specular bounce (or is the camera ray).
-    #[allow(clippy::too_many_arguments)]
-    fn emitted(
-        &self,
-        light: u32,
-        it: &Interaction,
-        wo: Vec3,
-        wl: &SampledWavelengths,
-        specular_bounce: bool,
-        pdf_bsdf: f64,
-        from: Vec3,
-    ) -> SampledSpectrum {
-        let scene = self.scene;
-        let l = &scene.lights[light as usize];
-        if !l.emits_toward(it.n, wo) {
-            return SampledSpectrum::ZERO;
-        }
-        let le = scene.light_spectrum(light, wl);
-        if specular_bounce {
-            return le;
-        }
-        let pdf_light = scene.light_sampler.pmf(light) * l.pdf_li(from, it.p, it.n);
-        le * power_heuristic(pdf_bsdf, pdf_light)
-    }
-
-    /// Radiance arriving from infinity along `d`: the infinite lights, MIS-weighted, and the
-    /// background colour (which no strategy but this one finds).
-    fn escaped(
-        &self,
-        d: Vec3,
-        wl: &SampledWavelengths,
-        specular_bounce: bool,
-        pdf_bsdf: f64,
-    ) -> SampledSpectrum {
-        let scene = self.scene;
-        let mut le = scene.background_spectrum(wl);
-        for &i in &scene.infinite_lights {
-            let light = &scene.lights[i as usize];
-            let radiance = scene.radiance_from_infinity(i, d, wl);
-            if specular_bounce {
-                le += radiance;
-            } else {
-                let pdf_light = scene.light_sampler.pmf(i) * light.pdf_direction(d);
-                le += radiance * power_heuristic(pdf_bsdf, pdf_light);
-            }
-        }
-        le
-    }
-
-    /// Next-event estimation: one light chosen by the light sampler, a point or direction on
-    /// it, a shadow ray, MIS-weighted against the BSDF's chance of that direction.
-    #[allow(clippy::too_many_arguments)]
-    fn sample_light(
-        &self,
-        it: &Interaction,
-        wo: Vec3,
-        bsdf: &crate::bxdf::Bsdf,
-        wl: &SampledWavelengths,
-        stream: &mut SampleStream,
-        counts: &mut RayCounts,
-        ray: &Ray,
-    ) -> SampledSpectrum {
-        let scene = self.scene;
-        let ul = stream.next_1d();
-        let u = stream.next_2d();
-        let Some((index, pmf)) = scene.light_sampler.sample(ul) else {
-            return SampledSpectrum::ZERO;
-        };
-        let light = &scene.lights[index as usize];
-        let Some(ls) = light.sample_li(it.p, u) else {
-            return SampledSpectrum::ZERO;
-        };
-        if ls.scale == 0.0 || ls.pdf == 0.0 {
-            return SampledSpectrum::ZERO;
-        }
-        let f = bsdf.f(wo, ls.wi, TransportMode::Radiance) * ls.wi.dot(it.shading_n).abs();
-        if f.is_black() {
-            return SampledSpectrum::ZERO;
-        }
-        counts.shadow += 1;
-        if self.occluded(it, &ls, ray.time) {
-            return SampledSpectrum::ZERO;
-        }
-        let le = match ls.radiance {
-            Some(c) => scene.rgb_radiance(c, wl),
-            None => scene.light_spectrum(index, wl) * ls.scale,
-        };
-        let pdf_light = pmf * ls.pdf;
-        if ls.delta {
-            return f * le / pdf_light;
-        }
-        let pdf_bsdf = bsdf.pdf(wo, ls.wi, TransportMode::Radiance);
-        f * le * (power_heuristic(pdf_light, pdf_bsdf) / pdf_light)
-    }
-
-    /// Whether anything opaque or not lies between the shaded point and the light sample:
-    /// in a physically based scene glass casts a shadow, and the light through it arrives
-    /// by BSDF sampling.
-    fn occluded(&self, it: &Interaction, ls: &LightSample, time: f64) -> bool {
-        let origin = offset_ray_origin(it.p, it.p_error, it.n, ls.wi);
-        let (shadow, t_max) = match ls.position {
-            Some(q) => (Ray::new(origin, q - origin), ls.shadow_end),
-            None => (Ray::new(origin, ls.wi), f64::INFINITY),
-        };
-        self.scene
-            .occluded(&shadow.at_time(time), t_max, Coherence::Incoherent)
     }
 }
 

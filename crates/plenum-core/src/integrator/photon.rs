@@ -2,7 +2,8 @@
 //! map (every photon landing on a diffuse or glossy surface) and a caustic map (photons that
 //! came L S+ D: only specular bounces since the light); the eye pass follows specular
 //! bounces to the first diffuse or glossy surface and adds there
-//! - direct light, by next-event estimation ([`super::photons::direct_light`]);
+//! - direct light, by next-event estimation weighed by MIS against the gather rays that
+//!   find an emitter ([`super::direct`]);
 //! - caustics, the caustic map's density estimate at that point;
 //! - indirect light, by final gathering: `gather_rays` rays sampled from the BSDF, each
 //!   taking the global map's density estimate at its first diffuse or glossy hit (after
@@ -24,9 +25,10 @@
 //! only after a gather bounce, so mostly where gather rays land close by: in corners) and
 //! the caustic map's caustics; docs/photon-mapping.md gives the measured values.
 
+use super::direct::{self, sample_ld};
 use super::light_tracing::rgb;
 use super::photon_map::{Nearest, Photon, PhotonMap, Query};
-use super::photons::{direct_light, emitted, escaped, shading_correction, PhotonTracer};
+use super::photons::{emitted, escaped, shading_correction, PhotonTracer};
 use super::{IntegratorConfig, PhotonConfig, RayCounts, RayKind, RayNode, RayTree};
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
@@ -157,7 +159,13 @@ impl<'a> PhotonMapper<'a> {
             };
             if bsdf.flags().is_non_specular() {
                 let time = ray.time;
-                l += beta * direct_light(scene, &it, wo, &bsdf, wl, stream, counts, time);
+                // The gather rays are the BSDF samples MIS weighs the light sample against.
+                let n = if e <= self.max_depth {
+                    self.gather_rays as f64
+                } else {
+                    0.0
+                };
+                l += beta * sample_ld(scene, &it, wo, &bsdf, wl, stream, counts, time, n);
                 l += beta * self.estimate(&self.caustic, &it, wo, &bsdf, wl, e);
                 l += beta * self.gather(&it, wo, &bsdf, wl, stream, counts, e, time);
                 break;
@@ -191,9 +199,10 @@ impl<'a> PhotonMapper<'a> {
     }
 
     /// Final gathering from the eye vertex `e`: the mean over the gather rays of the global
-    /// map's radiance at their first diffuse or glossy hit. Emitters a gather ray meets are
-    /// direct light (next-event estimation's) or caustics (the caustic map's), unless every
-    /// bounce from the eye vertex on was specular: that light neither strategy sees.
+    /// map's radiance at their first diffuse or glossy hit. An emitter a gather ray meets
+    /// first is direct light, its share under MIS with the light sample; one met after
+    /// specular bounces is a caustic (the caustic map's), unless every bounce from the eye
+    /// vertex on was specular: that light neither map holds.
     #[allow(clippy::too_many_arguments)]
     fn gather(
         &self,
@@ -207,6 +216,7 @@ impl<'a> PhotonMapper<'a> {
         time: f64,
     ) -> SampledSpectrum {
         let scene = self.scene;
+        let n = self.gather_rays as f64;
         let mut sum = SampledSpectrum::ZERO;
         for _ in 0..self.gather_rays {
             let (uc, u) = (stream.next_1d(), stream.next_2d());
@@ -215,6 +225,8 @@ impl<'a> PhotonMapper<'a> {
             };
             let mut w = bs.f * (bs.wi.dot(x.shading_n).abs() / bs.pdf);
             let mut delta = bs.is_specular();
+            let pdf_bsdf = direct::bsdf_pdf(bsdf, wo, &bs);
+            let first = e + 1;
             counts.reflection += 1;
             let mut ray =
                 Ray::new(offset_ray_origin(x.p, x.p_error, x.n, bs.wi), bs.wi).at_time(time);
@@ -223,15 +235,21 @@ impl<'a> PhotonMapper<'a> {
                     break;
                 }
                 let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
-                    sum += w * escaped(self.scene, ray.direction.normalized(), wl, delta);
+                    let d = ray.direction.normalized();
+                    sum += w * escaped(scene, d, wl, delta);
+                    if !delta && ez == first {
+                        sum += w * direct::infinite_mis(scene, d, wl, pdf_bsdf, n);
+                    }
                     break;
                 };
                 let it = scene.interaction(&ray, prim, &hit);
                 let wo_z = -ray.direction.normalized();
                 if delta {
-                    sum += w * emitted(self.scene, prim, &it, wo_z, wl);
+                    sum += w * emitted(scene, prim, &it, wo_z, wl);
                 } else if let Some(ke) = scene.phong_emission(&it, wl) {
                     sum += w * ke;
+                } else if let (Some(light), true) = (scene.light_of(prim), ez == first) {
+                    sum += w * direct::emitted_mis(scene, light, &it, wo_z, wl, pdf_bsdf, x.p, n);
                 }
                 let Some(bsdf_z) = scene.bsdf(&it, wo_z, wl) else {
                     break;

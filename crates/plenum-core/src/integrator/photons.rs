@@ -15,8 +15,7 @@
 
 use super::light_tracing::{adjoint_cosine, leave_light, start_light_path};
 use super::{IntegratorConfig, RayCounts};
-use crate::accel::Coherence;
-use crate::bxdf::{Bsdf, TransportMode};
+use crate::bxdf::TransportMode;
 use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::sampling::{Rng, SampleStream};
 use crate::scene::{Interaction, Scene};
@@ -144,53 +143,6 @@ pub(super) fn shading_correction(it: &Interaction, wi: Vec3) -> f64 {
         return 0.0;
     }
     wi.dot(it.shading_n).abs() / ng
-}
-
-/// Next-event estimation at an eye vertex, without MIS: the photon methods find no emitter
-/// by BSDF sampling (light reaching a surface from the lights is the photons' or this
-/// estimate's), so one light chosen by the light sampler, a point or direction on it and a
-/// shadow ray are the whole of direct light.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn direct_light(
-    scene: &Scene,
-    it: &Interaction,
-    wo: Vec3,
-    bsdf: &Bsdf,
-    wl: &SampledWavelengths,
-    stream: &mut SampleStream,
-    counts: &mut RayCounts,
-    time: f64,
-) -> SampledSpectrum {
-    let ul = stream.next_1d();
-    let u = stream.next_2d();
-    let Some((index, pmf)) = scene.light_sampler.sample(ul) else {
-        return SampledSpectrum::ZERO;
-    };
-    let light = &scene.lights[index as usize];
-    let Some(ls) = light.sample_li(it.p, u) else {
-        return SampledSpectrum::ZERO;
-    };
-    if ls.scale == 0.0 || ls.pdf == 0.0 {
-        return SampledSpectrum::ZERO;
-    }
-    let f = bsdf.f(wo, ls.wi, TransportMode::Radiance) * ls.wi.dot(it.shading_n).abs();
-    if f.is_black() {
-        return SampledSpectrum::ZERO;
-    }
-    counts.shadow += 1;
-    let origin = offset_ray_origin(it.p, it.p_error, it.n, ls.wi);
-    let (shadow, t_max) = match ls.position {
-        Some(q) => (Ray::new(origin, q - origin), ls.shadow_end),
-        None => (Ray::new(origin, ls.wi), f64::INFINITY),
-    };
-    if scene.occluded(&shadow.at_time(time), t_max, Coherence::Incoherent) {
-        return SampledSpectrum::ZERO;
-    }
-    let le = match ls.radiance {
-        Some(c) => scene.rgb_radiance(c, wl),
-        None => scene.light_spectrum(index, wl) * ls.scale,
-    };
-    f * le / (pmf * ls.pdf)
 }
 
 /// What an emitter hit by the camera ray or a specular chain shows toward `wo` (a light's

@@ -1,8 +1,9 @@
 //! Stochastic progressive photon mapping (Hachisuka and Jensen 2009), in the structure of
 //! pbrt-v3's `SPPMIntegrator` (§16.2): iteration after iteration,
 //! 1. a camera pass traces one path per pixel through specular bounces to its first diffuse
-//!    or glossy surface, adds the light seen on the way and that point's direct light (by
-//!    next-event estimation), and leaves a *visible point* there;
+//!    or glossy surface, adds the light seen on the way and that point's direct light (a
+//!    light sample and a BSDF sample under MIS, [`super::direct`]), and leaves a *visible
+//!    point* there;
 //! 2. the visible points go into a hash grid, each in every cell its radius overlaps;
 //! 3. a photon pass traces photon paths; where one lands (after at least one bounce: direct
 //!    light is the camera pass's) every visible point within its pixel's radius takes the
@@ -27,8 +28,9 @@
 //! Visible points are made at the first surface with a diffuse or glossy lobe: a BSDF that
 //! also has a specular lobe (a smooth coat) is seen there without it.
 
+use super::direct::{bsdf_sample_ld, sample_ld};
 use super::light_tracing::rgb;
-use super::photons::{direct_light, emitted, escaped, PhotonTracer};
+use super::photons::{emitted, escaped, PhotonTracer};
 use super::RayCounts;
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
@@ -288,7 +290,14 @@ impl Eye<'_> {
                 break;
             };
             if bsdf.flags().is_non_specular() {
-                l += beta * direct_light(scene, &it, wo, &bsdf, &wl, &mut stream, counts, ray.time);
+                // Direct light by MIS of a light sample and one BSDF sample (none at the
+                // last vertex, where a path would not bounce).
+                let t = ray.time;
+                let n = if e <= max_depth { 1.0 } else { 0.0 };
+                l += beta * sample_ld(scene, &it, wo, &bsdf, &wl, &mut stream, counts, t, n);
+                if e <= max_depth {
+                    l += beta * bsdf_sample_ld(scene, &it, wo, &bsdf, &wl, &mut stream, counts, t);
+                }
                 if px.radius == 0.0 {
                     px.radius = match s.integrator.photon.radius {
                         r if r > 0.0 => r,

@@ -7,12 +7,14 @@
 pub(crate) mod chi_square;
 mod distribution;
 mod filter;
+mod mis;
 mod pixel;
 mod rng;
 mod warp;
 
 pub use distribution::{AliasTable, PiecewiseConstant1D, PiecewiseConstant2D};
 pub use filter::{Filter, FilterKind, FilterSample};
+pub use mis::power_heuristic;
 pub use pixel::{permute, PixelSampler, SampleStream, SamplerKind, MAX_SPP};
 pub use rng::Rng;
 pub use warp::*;

@@ -3,7 +3,7 @@
 #![allow(dead_code)]
 
 use plenum_core::integrator::{ColorMode, IntegratorConfig, IntegratorKind};
-use plenum_core::render::{render, RenderSettings};
+use plenum_core::render::{render, RenderOutput, RenderSettings};
 use plenum_core::sampling::{PixelSampler, SamplerKind};
 use plenum_scene::{load_scene, parse_scene, LoadedScene};
 use std::path::{Path, PathBuf};
@@ -41,13 +41,18 @@ pub fn path_settings(l: &LoadedScene, spp: u32, color: ColorMode, seed: u64) -> 
     settings_for(l, IntegratorKind::Path, spp, color, seed)
 }
 
-pub fn draw(l: &LoadedScene, settings: &RenderSettings) -> Vec<[f32; 3]> {
+/// Renders `l`; no sample may come out NaN or infinite.
+pub fn render_checked(l: &LoadedScene, settings: &RenderSettings) -> RenderOutput {
     let out = render(&l.scene, settings, &AtomicBool::new(false), &|_, _| {});
     assert_eq!(
         out.counts.invalid, 0,
         "no sample may come out NaN or infinite"
     );
-    out.film.pixels().to_vec()
+    out
+}
+
+pub fn draw(l: &LoadedScene, settings: &RenderSettings) -> Vec<[f32; 3]> {
+    render_checked(l, settings).film.pixels().to_vec()
 }
 
 pub fn mean(pixels: &[[f32; 3]]) -> [f64; 3] {
@@ -58,6 +63,38 @@ pub fn mean(pixels: &[[f32; 3]]) -> [f64; 3] {
         }
     }
     m.map(|v| v / pixels.len() as f64)
+}
+
+/// pbrt-v4's three furnaces, as (what, light, sphere emission) for [`furnace`]: a central
+/// point light of intensity π, four of π/4 close by, or the sphere's own emission 0.5. In each
+/// the radiance everywhere is 1: L = ρ/π·E + ρ·L with E = I/r² = π, or L = L_e + ρ·L.
+pub fn furnace_cases() -> Vec<(&'static str, String, String)> {
+    let pi = std::f64::consts::PI;
+    let point = |p: [f64; 3], i: f64| {
+        format!("[[lights]]\ntype = \"point\"\nposition = {p:?}\nintensity = {i}\n")
+    };
+    let four: String = [
+        [0.1, 0.0, 0.0],
+        [-0.1, 0.0, 0.0],
+        [0.0, 0.1, 0.0],
+        [0.0, -0.1, 0.0],
+    ]
+    .into_iter()
+    .map(|p| point(p, pi / 4.0))
+    .collect();
+    vec![
+        (
+            "a central point light of intensity π",
+            point([0.0; 3], pi),
+            String::new(),
+        ),
+        ("four point lights of intensity π/4", four, String::new()),
+        (
+            "the sphere's own emission 0.5",
+            String::new(),
+            "emission = [0.5, 0.5, 0.5]".into(),
+        ),
+    ]
 }
 
 /// The camera inside a sphere of radius 1 and reflectance 0.5: pbrt-v4's analytic scenes.

@@ -1,0 +1,173 @@
+//! Direct light at a surface by multiple importance sampling (Veach and Guibas 1995): light
+//! sampling (one light chosen by the light sampler, a point or direction on it, a shadow ray)
+//! weighed by the power heuristic against BSDF sampling (rays drawn from the BSDF that find
+//! an emitter). The path tracer, photon mapping and SPPM share it.
+//!
+//! `bsdf_samples` is how many BSDF-sampled rays leave the point beside the one light sample:
+//! 1 for a path's next bounce, the gather count for photon mapping's final gather. With n of
+//! them the multi-sample power heuristic (Veach's thesis §9.2.4) weighs the light sample by
+//! p_l² / (p_l² + (n·p_b)²) and each BSDF sample by (n·p_b)² / (p_l² + (n·p_b)²), and the
+//! BSDF samples' sum is divided by n.
+
+use super::RayCounts;
+use crate::accel::Coherence;
+use crate::bxdf::{Bsdf, TransportMode};
+use crate::light::LightSample;
+use crate::math::{offset_ray_origin, Ray, Vec3};
+use crate::sampling::{power_heuristic, SampleStream};
+use crate::scene::{Interaction, Scene};
+use plenum_spectrum::{SampledSpectrum, SampledWavelengths};
+
+/// The light sample's part of direct light at `it` toward `wo`, weighed against
+/// `bsdf_samples` BSDF-sampled rays (0: light sampling alone).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn sample_ld(
+    scene: &Scene,
+    it: &Interaction,
+    wo: Vec3,
+    bsdf: &Bsdf,
+    wl: &SampledWavelengths,
+    stream: &mut SampleStream,
+    counts: &mut RayCounts,
+    time: f64,
+    bsdf_samples: f64,
+) -> SampledSpectrum {
+    let ul = stream.next_1d();
+    let u = stream.next_2d();
+    let Some((index, pmf)) = scene.light_sampler.sample(ul) else {
+        return SampledSpectrum::ZERO;
+    };
+    let light = &scene.lights[index as usize];
+    let Some(ls) = light.sample_li(it.p, u) else {
+        return SampledSpectrum::ZERO;
+    };
+    if ls.scale == 0.0 || ls.pdf == 0.0 {
+        return SampledSpectrum::ZERO;
+    }
+    let f = bsdf.f(wo, ls.wi, TransportMode::Radiance) * ls.wi.dot(it.shading_n).abs();
+    if f.is_black() {
+        return SampledSpectrum::ZERO;
+    }
+    counts.shadow += 1;
+    if occluded(scene, it, &ls, time) {
+        return SampledSpectrum::ZERO;
+    }
+    let le = match ls.radiance {
+        Some(c) => scene.rgb_radiance(c, wl),
+        None => scene.light_spectrum(index, wl) * ls.scale,
+    };
+    let pdf_light = pmf * ls.pdf;
+    if ls.delta || bsdf_samples == 0.0 {
+        return f * le / pdf_light;
+    }
+    let pdf_bsdf = bsdf.pdf(wo, ls.wi, TransportMode::Radiance);
+    f * le * (power_heuristic(pdf_light, bsdf_samples * pdf_bsdf) / pdf_light)
+}
+
+/// Whether anything opaque or not lies between the shaded point and the light sample:
+/// in a physically based scene glass casts a shadow, and the light through it arrives
+/// by BSDF sampling (or, for the photon methods, by photons).
+fn occluded(scene: &Scene, it: &Interaction, ls: &LightSample, time: f64) -> bool {
+    let origin = offset_ray_origin(it.p, it.p_error, it.n, ls.wi);
+    let (shadow, t_max) = match ls.position {
+        Some(q) => (Ray::new(origin, q - origin), ls.shadow_end),
+        None => (Ray::new(origin, ls.wi), f64::INFINITY),
+    };
+    scene.occluded(&shadow.at_time(time), t_max, Coherence::Incoherent)
+}
+
+/// A BSDF-sampled ray's part of direct light: the radiance of area light `light`, hit at
+/// `it`, toward `wo`, weighed against light sampling from `from` (the ray came from there
+/// with solid-angle pdf `pdf_bsdf`, one of `bsdf_samples`; an infinite pdf, a specular
+/// bounce's or the camera's, takes it in full).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn emitted_mis(
+    scene: &Scene,
+    light: u32,
+    it: &Interaction,
+    wo: Vec3,
+    wl: &SampledWavelengths,
+    pdf_bsdf: f64,
+    from: Vec3,
+    bsdf_samples: f64,
+) -> SampledSpectrum {
+    let l = &scene.lights[light as usize];
+    if !l.emits_toward(it.n, wo) {
+        return SampledSpectrum::ZERO;
+    }
+    let pdf_light = scene.light_sampler.pmf(light) * l.pdf_li(from, it.p, it.n);
+    scene.light_spectrum(light, wl) * power_heuristic(bsdf_samples * pdf_bsdf, pdf_light)
+}
+
+/// A BSDF-sampled ray's part of the light from infinity along `d`: the infinite lights,
+/// each weighed against light sampling.
+pub(super) fn infinite_mis(
+    scene: &Scene,
+    d: Vec3,
+    wl: &SampledWavelengths,
+    pdf_bsdf: f64,
+    bsdf_samples: f64,
+) -> SampledSpectrum {
+    let mut le = SampledSpectrum::ZERO;
+    for &i in &scene.infinite_lights {
+        let pdf_light = scene.light_sampler.pmf(i) * scene.lights[i as usize].pdf_direction(d);
+        le += scene.radiance_from_infinity(i, d, wl)
+            * power_heuristic(bsdf_samples * pdf_bsdf, pdf_light);
+    }
+    le
+}
+
+/// The solid-angle pdf by which the BSDF chose `bs`, for weighing it against light
+/// sampling (a sampler that returns a pdf only proportional to it asks the BSDF).
+#[inline]
+pub(super) fn bsdf_pdf(bsdf: &Bsdf, wo: Vec3, bs: &crate::bxdf::BsdfSample) -> f64 {
+    if bs.pdf_is_proportional {
+        bsdf.pdf(wo, bs.wi, TransportMode::Radiance)
+    } else {
+        bs.pdf
+    }
+}
+
+/// One BSDF-sampled ray's part of direct light at `it` toward `wo`, for a method whose path
+/// does not go on from `it` (SPPM's visible point): the emitter or infinite light it finds,
+/// weighed against one light sample. A specular lobe's direction counts in full: light
+/// sampling cannot find it.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn bsdf_sample_ld(
+    scene: &Scene,
+    it: &Interaction,
+    wo: Vec3,
+    bsdf: &Bsdf,
+    wl: &SampledWavelengths,
+    stream: &mut SampleStream,
+    counts: &mut RayCounts,
+    time: f64,
+) -> SampledSpectrum {
+    let (uc, u) = (stream.next_1d(), stream.next_2d());
+    let Some(bs) = bsdf.sample_f(wo, uc, u, TransportMode::Radiance) else {
+        return SampledSpectrum::ZERO;
+    };
+    let beta = bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
+    if beta.is_black() {
+        return SampledSpectrum::ZERO;
+    }
+    if bs.is_transmission() {
+        counts.refraction += 1;
+    } else {
+        counts.reflection += 1;
+    }
+    // A specular direction's infinite pdf gives its light the whole weight.
+    let pdf_bsdf = match bs.is_specular() {
+        true => f64::INFINITY,
+        false => bsdf_pdf(bsdf, wo, &bs),
+    };
+    let ray = Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(time);
+    let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
+        return beta * infinite_mis(scene, bs.wi, wl, pdf_bsdf, 1.0);
+    };
+    let Some(light) = scene.light_of(prim) else {
+        return SampledSpectrum::ZERO;
+    };
+    let hit_it = scene.interaction(&ray, prim, &hit);
+    beta * emitted_mis(scene, light, &hit_it, -bs.wi, wl, pdf_bsdf, it.p, 1.0)
+}
