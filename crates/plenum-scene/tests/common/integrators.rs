@@ -146,15 +146,32 @@ pub fn read_exr(p: &Path) -> Vec<[f32; 3]> {
 /// must pass, and the squared error must be what the two variances predict (its ratio to
 /// them within 0.8–1.25).
 pub fn cbox_z_test(kind: IntegratorKind, color: ColorMode, reference: &str, variance: &str) {
+    cbox_z_test_with(kind, color, reference, variance, 16, |_| {});
+}
+
+/// [`cbox_z_test`] of renders at `spp` samples (iterations) per pixel, their settings
+/// changed by `tweak`.
+pub fn cbox_z_test_with(
+    kind: IntegratorKind,
+    color: ColorMode,
+    reference: &str,
+    variance: &str,
+    spp: u32,
+    tweak: impl Fn(&mut RenderSettings),
+) {
     let (Some(r), Some(v)) = (cbox_reference(reference), cbox_reference(variance)) else {
         eprintln!("../shared/data/references/cbox is not here: the Cornell box z-test has nothing to compare with");
         return;
     };
     let (reference, ref_var) = (read_exr(&r), read_exr(&v));
     let l = load_cornell_box();
-    let (renders, spp) = (16u64, 16);
+    let renders = 16u64;
     let images: Vec<Vec<[f32; 3]>> = (0..renders)
-        .map(|seed| draw(&l, &settings_for(&l, kind, spp, color, 1000 + seed)))
+        .map(|seed| {
+            let mut s = settings_for(&l, kind, spp, color, 1000 + seed);
+            tweak(&mut s);
+            draw(&l, &s)
+        })
         .collect();
     assert_eq!(images[0].len(), reference.len());
     let n = (reference.len() * 3) as f64;
