@@ -52,6 +52,9 @@ pub fn run(args: TracePixelArgs) -> ExitCode {
     ExitCode::SUCCESS
 }
 
+/// The photons of a density estimate the text listing shows; `--json` gives them all.
+const PHOTONS_LISTED: usize = 8;
+
 fn rgb(c: Color) -> Value {
     json!([c.r, c.g, c.b])
 }
@@ -78,6 +81,19 @@ fn node_json(id: usize, n: &RayNode) -> Value {
     });
     if let Some(s) = &n.strategy {
         v["strategy"] = json!({"s": s.s, "t": s.t, "mis_weight": s.mis_weight, "unweighted": rgb(s.unweighted)});
+    }
+    if let Some(g) = &n.photons {
+        v["photons"] = json!({
+            "source": g.source,
+            "radius": g.radius,
+            "estimate": rgb(g.estimate),
+            "found": g.photons.iter().map(|p| json!({
+                "position": xyz(p.position),
+                "wi": xyz(p.wi),
+                "power": rgb(p.power),
+                "distance": p.distance,
+            })).collect::<Vec<_>>(),
+        });
     }
     if let Some(s) = &n.shadow {
         v["light"] = json!(s.light);
@@ -141,6 +157,32 @@ fn print_node(out: &mut String, tree: &RayTree, id: usize, indent: usize) {
             fmt_color(s.unweighted),
             s.mis_weight
         );
+    }
+    if let Some(g) = &n.photons {
+        let _ = writeln!(
+            out,
+            "{pad}  {}: {} photons within radius {:.5}, giving {}",
+            g.source,
+            g.photons.len(),
+            g.radius,
+            fmt_color(g.estimate)
+        );
+        for p in g.photons.iter().take(PHOTONS_LISTED) {
+            let _ = writeln!(
+                out,
+                "{pad}    photon at {}, {:.5} away, arriving from {}, flux ({:.3e}, {:.3e}, {:.3e})",
+                fmt_vec(p.position),
+                p.distance,
+                fmt_vec(p.wi),
+                p.power.r,
+                p.power.g,
+                p.power.b
+            );
+        }
+        if g.photons.len() > PHOTONS_LISTED {
+            let more = g.photons.len() - PHOTONS_LISTED;
+            let _ = writeln!(out, "{pad}    … {more} more (--json lists them all)");
+        }
     }
     if n.total_internal_reflection {
         let _ = writeln!(

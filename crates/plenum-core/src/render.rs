@@ -596,8 +596,12 @@ fn corner_stream(seed: u64, x: u32, y: u32) -> SampleStream {
     SampleStream::random(Rng::for_sample(seed, x, y, u32::MAX))
 }
 
-/// The ray tree of one pixel: every ray of every sample, and the pixel's colour.
+/// The ray tree of one pixel: every ray of every sample, and the pixel's colour (SPPM: its
+/// first iteration, [`crate::integrator::sppm::trace_pixel`]).
 pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> (RayTree, Color) {
+    if settings.integrator.kind == IntegratorKind::Sppm {
+        return crate::integrator::sppm::trace_pixel(scene, settings, x, y);
+    }
     let camera = Camera::new(&scene.camera, settings.width, settings.height);
     let splats = SplatBuffer::new(settings.width, settings.height, 1.0);
     let integrator = Integrator::new(

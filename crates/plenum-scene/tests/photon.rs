@@ -10,7 +10,7 @@ use common::integrators::{
 };
 
 use plenum_core::integrator::{ColorMode, IntegratorKind, PhotonConfig};
-use plenum_core::render::RenderSettings;
+use plenum_core::render::{trace_pixel, RenderSettings};
 use plenum_scene::{parse_scene, LoadedScene};
 use std::path::Path;
 
@@ -366,4 +366,68 @@ fn bad_photon_settings_give_clear_errors() {
     let l = scene(&good);
     let back = scene(&plenum_scene::to_toml(&l.scene, &l.defaults));
     assert_eq!(back.defaults.photon, d);
+}
+
+/// `trace-pixel` for the photon methods lists the photons each density estimate used: all
+/// within its radius, nearest first, at most k per estimate for photon mapping; for SPPM the
+/// pixel's colour is what one iteration renders there (to 10⁻⁴: the render sums photons in
+/// fixed point).
+#[test]
+fn trace_pixel_lists_the_photons_found() {
+    let l = load_cornell_box();
+    let (x, y) = (100, 230);
+    for kind in [IntegratorKind::Photon, IntegratorKind::Sppm] {
+        let p = PhotonConfig {
+            photons: 20_000,
+            caustic_photons: 0,
+            nearest: 32,
+            ..Default::default()
+        };
+        // Photon mapping: every ray of 8 samples; SPPM: its first iteration.
+        let s = settings(&l, kind, 8, ColorMode::Rgb, p, 4);
+        let (tree, color) = trace_pixel(&l.scene, &s, x, y);
+        let gathers: Vec<_> = tree
+            .nodes
+            .iter()
+            .filter_map(|n| n.photons.as_ref())
+            .collect();
+        assert!(
+            !gathers.is_empty(),
+            "{}: no density estimate recorded",
+            kind.name()
+        );
+        let mut total = 0;
+        for g in &gathers {
+            total += g.photons.len();
+            if kind == IntegratorKind::Photon {
+                assert!(
+                    g.photons.len() <= 32,
+                    "{} photons for k = 32",
+                    g.photons.len()
+                );
+            }
+            for pair in g.photons.windows(2) {
+                assert!(pair[0].distance <= pair[1].distance, "nearest first");
+            }
+            for ph in &g.photons {
+                assert!(
+                    ph.distance <= g.radius * (1.0 + 1e-5),
+                    "{}: a photon outside the radius",
+                    kind.name()
+                );
+            }
+        }
+        assert!(total > 0, "{}: no photon found at the floor", kind.name());
+        if kind == IntegratorKind::Sppm {
+            let image = draw(&l, &settings(&l, kind, 1, ColorMode::Rgb, p, 4));
+            let rendered = image[(y * s.width + x) as usize];
+            for (c, v) in [color.r, color.g, color.b].into_iter().enumerate() {
+                assert!(
+                    (v - rendered[c] as f64).abs() <= 1e-4 * (1.0 + v.abs()),
+                    "channel {c}: trace-pixel gives {v}, the render {}",
+                    rendered[c]
+                );
+            }
+        }
+    }
 }

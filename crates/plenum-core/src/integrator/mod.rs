@@ -21,7 +21,9 @@ pub use light_tracing::LightTracer;
 pub use medium::MediumStack;
 pub use path::PathTracer;
 pub use photon::PhotonMapper;
-pub use ray_tree::{RayKind, RayNode, RayTree, ShadowInfo, Stop, Strategy};
+pub use ray_tree::{
+    FoundPhoton, PhotonGather, RayKind, RayNode, RayTree, ShadowInfo, Stop, Strategy,
+};
 pub use whitted::{RayCounts, Whitted, WhittedConfig, MAX_DEPTH};
 
 use crate::camera::Camera;
@@ -301,4 +303,27 @@ impl<'a> Integrator<'a> {
             _ => RayCounts::default(),
         }
     }
+}
+
+/// Applies `f` to node `node` of the ray tree, where a tree is being recorded.
+fn record(tree: &mut Option<&mut RayTree>, node: Option<usize>, f: impl FnOnce(&mut RayNode)) {
+    if let (Some(t), Some(i)) = (tree.as_deref_mut(), node) {
+        f(&mut t.nodes[i]);
+    }
+}
+
+/// Records in node `node` the object and material of primitive `prim`, hit at `distance`.
+fn record_hit(
+    tree: &mut Option<&mut RayTree>,
+    node: Option<usize>,
+    scene: &Scene,
+    prim: u32,
+    distance: f64,
+) {
+    record(tree, node, |n| {
+        n.object = Some(scene.object_names[prim as usize].clone());
+        let m = scene.primitives[prim as usize].material as usize;
+        n.material = Some(scene.material_names[m].clone());
+        n.distance = Some(distance);
+    });
 }

@@ -11,7 +11,9 @@
 //! into linear sRGB once at the end. A sample that comes out NaN or infinite is counted in
 //! [`RayCounts::invalid`] and left out of the film.
 
-use super::{direct, IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Stop};
+use super::{
+    direct, record, record_hit, IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Stop,
+};
 use crate::bxdf::TransportMode;
 use crate::color::Color;
 use crate::math::{offset_ray_origin, Ray};
@@ -111,15 +113,7 @@ impl<'a> PathTracer<'a> {
             };
             let it = scene.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
-            if let Some(t) = tree.as_deref_mut() {
-                if let Some(i) = node {
-                    let n = &mut t.nodes[i];
-                    n.object = Some(scene.object_names[prim as usize].clone());
-                    let m = scene.primitives[prim as usize].material as usize;
-                    n.material = Some(scene.material_names[m].clone());
-                    n.distance = Some(hit.t * ray.direction.length());
-                }
-            }
+            record_hit(&mut tree, node, scene, prim, hit.t * ray.direction.length());
 
             // Light the path finds on its own, weighed against light sampling's chance of
             // having found it.
@@ -198,11 +192,5 @@ impl<'a> PathTracer<'a> {
             }
         }
         l
-    }
-}
-
-fn record(tree: &mut Option<&mut RayTree>, node: Option<usize>, f: impl FnOnce(&mut RayNode)) {
-    if let (Some(t), Some(i)) = (tree.as_deref_mut(), node) {
-        f(&mut t.nodes[i]);
     }
 }

@@ -29,7 +29,10 @@ use super::direct::{self, sample_ld};
 use super::light_tracing::rgb;
 use super::photon_map::{Nearest, Photon, PhotonMap, Query};
 use super::photons::{emitted, escaped, shading_correction, PhotonTracer};
-use super::{IntegratorConfig, PhotonConfig, RayCounts, RayKind, RayNode, RayTree};
+use super::{
+    record, record_hit, FoundPhoton, IntegratorConfig, PhotonConfig, PhotonGather, RayCounts,
+    RayKind, RayNode, RayTree,
+};
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
 use crate::color::Color;
@@ -152,6 +155,7 @@ impl<'a> PhotonMapper<'a> {
             };
             let it = scene.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
+            record_hit(&mut tree, node, scene, prim, hit.t * ray.direction.length());
             // Only the camera ray and specular bounces get here: emitters count in full.
             l += beta * emitted(self.scene, prim, &it, wo, wl);
             let Some(bsdf) = scene.bsdf(&it, wo, wl) else {
@@ -166,8 +170,24 @@ impl<'a> PhotonMapper<'a> {
                     0.0
                 };
                 l += beta * sample_ld(scene, &it, wo, &bsdf, wl, stream, counts, time, n);
-                l += beta * self.estimate(&self.caustic, &it, wo, &bsdf, wl, e);
-                l += beta * self.gather(&it, wo, &bsdf, wl, stream, counts, e, time);
+                let mut found = (tree.is_some() && !self.caustic.is_empty()).then(Vec::new);
+                let (caustic, r2) =
+                    self.estimate(&self.caustic, &it, wo, &bsdf, wl, e, found.as_mut());
+                l += beta * caustic;
+                if let Some(photons) = found {
+                    record(&mut tree, node, |n| {
+                        n.photons = Some(PhotonGather {
+                            source: "caustic map",
+                            radius: r2.sqrt(),
+                            photons,
+                            estimate: rgb(beta * caustic, wl),
+                        })
+                    });
+                }
+                let gathered =
+                    self.gather(&it, wo, &bsdf, wl, stream, counts, e, time, &mut tree, node);
+                l += beta * gathered;
+                record(&mut tree, node, |n| n.color = rgb(l, wl));
                 break;
             }
             if e == self.max_depth + 1 {
@@ -214,6 +234,8 @@ impl<'a> PhotonMapper<'a> {
         counts: &mut RayCounts,
         e: u32,
         time: f64,
+        tree: &mut Option<&mut RayTree>,
+        parent: Option<usize>,
     ) -> SampledSpectrum {
         let scene = self.scene;
         let n = self.gather_rays as f64;
@@ -225,6 +247,18 @@ impl<'a> PhotonMapper<'a> {
             };
             let mut w = bs.f * (bs.wi.dot(x.shading_n).abs() / bs.pdf);
             let mut delta = bs.is_specular();
+            // A gather ray and its specular continuation are one node of the ray tree.
+            let node = tree.as_deref_mut().map(|t| {
+                t.push(RayNode::new(
+                    parent,
+                    RayKind::Reflected,
+                    e,
+                    x.p,
+                    bs.wi,
+                    rgb(w, wl),
+                ))
+            });
+            let before = sum;
             let pdf_bsdf = direct::bsdf_pdf(bsdf, wo, &bs);
             let first = e + 1;
             counts.reflection += 1;
@@ -255,7 +289,21 @@ impl<'a> PhotonMapper<'a> {
                     break;
                 };
                 if bsdf_z.flags().is_non_specular() {
-                    sum += w * self.estimate(&self.global, &it, wo_z, &bsdf_z, wl, ez);
+                    let mut found = tree.is_some().then(Vec::new);
+                    let (global, r2) =
+                        self.estimate(&self.global, &it, wo_z, &bsdf_z, wl, ez, found.as_mut());
+                    sum += w * global;
+                    if let Some(photons) = found {
+                        record_hit(tree, node, scene, prim, hit.t * ray.direction.length());
+                        record(tree, node, |n| {
+                            n.photons = Some(PhotonGather {
+                                source: "global map",
+                                radius: r2.sqrt(),
+                                photons,
+                                estimate: rgb(w * global, wl),
+                            })
+                        });
+                    }
                     break;
                 }
                 if ez == self.max_depth + 1 {
@@ -271,12 +319,14 @@ impl<'a> PhotonMapper<'a> {
                 ray =
                     Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(time);
             }
+            record(tree, node, |nd| nd.color = rgb((sum - before) / n, wl));
         }
         sum / self.gather_rays.max(1) as f64
     }
 
     /// The radiance the photons of `map` near `it` send toward `wo`, from photons no deeper
-    /// than an eye vertex `e` may join.
+    /// than an eye vertex `e` may join, and the squared radius they were gathered in; with
+    /// `found`, the photons used are listed there.
     #[allow(clippy::too_many_arguments)]
     fn estimate(
         &self,
@@ -286,10 +336,11 @@ impl<'a> PhotonMapper<'a> {
         bsdf: &Bsdf,
         wl: &SampledWavelengths,
         e: u32,
-    ) -> SampledSpectrum {
+        mut found_photons: Option<&mut Vec<FoundPhoton>>,
+    ) -> (SampledSpectrum, f64) {
         let max_depth = (self.max_depth + 2).saturating_sub(e);
         if map.is_empty() || max_depth == 0 {
-            return SampledSpectrum::ZERO;
+            return (SampledSpectrum::ZERO, 0.0);
         }
         let k = self.nearest + 1;
         let q = Query {
@@ -308,7 +359,7 @@ impl<'a> PhotonMapper<'a> {
             _ => (self.max_distance2 as f64, None),
         };
         if r2 <= 0.0 {
-            return SampledSpectrum::ZERO;
+            return (SampledSpectrum::ZERO, 0.0);
         }
         let mut sum = SampledSpectrum::ZERO;
         for &(_, i) in found {
@@ -323,8 +374,20 @@ impl<'a> PhotonMapper<'a> {
             }
             let power = Color::new(ph.power[0] as f64, ph.power[1] as f64, ph.power[2] as f64);
             sum += f * self.scene.rgb_radiance(power, wl) * shading_correction(it, wi);
+            if let Some(list) = found_photons.as_deref_mut() {
+                let position = Vec3::new(ph.p[0] as f64, ph.p[1] as f64, ph.p[2] as f64);
+                list.push(FoundPhoton {
+                    position,
+                    wi,
+                    power,
+                    distance: (position - it.p).length(),
+                });
+            }
         }
-        sum / (std::f64::consts::PI * r2)
+        if let Some(list) = found_photons {
+            list.sort_by(|a, b| a.distance.total_cmp(&b.distance));
+        }
+        (sum / (std::f64::consts::PI * r2), r2)
     }
 }
 

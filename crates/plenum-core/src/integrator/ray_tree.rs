@@ -91,6 +91,31 @@ pub struct RayNode {
     pub shadow: Option<ShadowInfo>,
     /// For a bidirectional connection: which strategy it is and how it was weighed.
     pub strategy: Option<Strategy>,
+    /// For photon mapping and SPPM: the photons a density estimate at this hit found.
+    pub photons: Option<PhotonGather>,
+}
+
+/// The photons found around one point by a density estimate, and what they give.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhotonGather {
+    /// Where they come from: "caustic map", "global map", or "SPPM photon pass".
+    pub source: &'static str,
+    /// The radius they were gathered in.
+    pub radius: f64,
+    pub photons: Vec<FoundPhoton>,
+    /// The radiance toward the eye they give, linear sRGB.
+    pub estimate: Color,
+}
+
+/// One photon of a [`PhotonGather`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FoundPhoton {
+    pub position: Vec3,
+    /// Unit direction it arrived from (toward where it came from).
+    pub wi: Vec3,
+    /// Its flux, linear sRGB.
+    pub power: Color,
+    pub distance: f64,
 }
 
 /// One connection strategy of bidirectional path tracing: s vertices from the light, t from
@@ -129,6 +154,7 @@ impl RayNode {
             total_internal_reflection: false,
             shadow: None,
             strategy: None,
+            photons: None,
         }
     }
 }

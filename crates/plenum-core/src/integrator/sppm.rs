@@ -30,8 +30,10 @@
 
 use super::direct::{bsdf_sample_ld, sample_ld};
 use super::light_tracing::rgb;
-use super::photons::{emitted, escaped, PhotonTracer};
-use super::RayCounts;
+use super::photons::{emitted, escaped, Arrival, PhotonTracer};
+use super::{
+    record, record_hit, FoundPhoton, PhotonGather, RayCounts, RayKind, RayNode, RayTree, Stop,
+};
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
 use crate::color::Color;
@@ -64,6 +66,36 @@ struct VisiblePoint {
     /// The eye vertex: 1 for the camera ray's hit.
     depth: u32,
     wl: SampledWavelengths,
+}
+
+impl VisiblePoint {
+    /// The flux photon arrival `a` (at the wavelengths `pwl`) brings this visible point of
+    /// gather radius `r`, linear sRGB: its throughput times the BSDF times the photon's flux;
+    /// `None` if the photon lands outside the radius or makes a path longer than allowed.
+    fn photon_flux(
+        &self,
+        r: f64,
+        a: &Arrival,
+        pwl: &SampledWavelengths,
+        max_depth: u32,
+    ) -> Option<Color> {
+        if (self.p - a.it.p).length_squared() > r * r || self.depth + a.depth > max_depth + 2 {
+            return None;
+        }
+        let f = self.bsdf.f(self.wo, a.wi, TransportMode::Radiance);
+        let ng = a.wi.dot(self.n).abs();
+        if f.is_black() || ng == 0.0 {
+            return None;
+        }
+        let correction = a.wi.dot(self.shading_n).abs() / ng;
+        // A dispersive photon path carries its hero wavelength alone.
+        let both = if pwl.secondary_terminated() {
+            pwl
+        } else {
+            &self.wl
+        };
+        Some(rgb(self.beta * f * a.beta * correction, both))
+    }
 }
 
 /// A pixel's running estimate.
@@ -100,29 +132,19 @@ pub fn render(
     let config = &settings.integrator;
     let iterations = settings.sampler.samples_per_pixel().max(1);
     let pixel_count = w as usize * h as usize;
-    let photons = match config.photon.sppm_photons {
-        0 => pixel_count as u64,
-        n => n,
-    };
+    let photons = photons_per_iteration(settings);
     let alpha = config.photon.alpha;
     let tracer = PhotonTracer::new(scene, config);
     let mut pixels = vec![PixelState::default(); pixel_count];
     let sums: Vec<PhotonSums> = (0..pixel_count).map(|_| PhotonSums::default()).collect();
     let mut grid = Grid::default();
     let mut counts = RayCounts::default();
-    let u0 = Rng::new(settings.seed, 0x5350_504d).uniform();
     let mut done = 0u32;
     for iteration in 0..iterations {
         if cancel.load(Ordering::Relaxed) {
             break;
         }
-        let wl = match config.color {
-            ColorMode::Spectral => {
-                let u = (u0 + iteration as f64 * 0.618_033_988_749_894_9).fract();
-                SampledWavelengths::sample_visible(u)
-            }
-            ColorMode::Rgb => SampledWavelengths::rgb(),
-        };
+        let wl = iteration_wavelengths(settings, iteration);
         let eye = Eye {
             scene,
             camera: &camera,
@@ -134,7 +156,7 @@ pub fn render(
             .par_iter_mut()
             .enumerate()
             .fold(RayCounts::default, |mut c, (i, px)| {
-                eye.camera_path(i as u32 % w, i as u32 / w, px, &mut c);
+                eye.camera_path(i as u32 % w, i as u32 / w, px, &mut c, None);
                 c
             })
             .reduce(RayCounts::default, add_counts);
@@ -157,30 +179,14 @@ pub fn render(
                             return true;
                         }
                         for &i in grid_now.near(a.it.p) {
-                            let Some(vp) = &pixels_now[i as usize].vp else {
+                            let px = &pixels_now[i as usize];
+                            let Some(phi) = px
+                                .vp
+                                .as_ref()
+                                .and_then(|vp| vp.photon_flux(px.radius, a, pwl, max_depth))
+                            else {
                                 continue;
                             };
-                            let r = pixels_now[i as usize].radius;
-                            if (vp.p - a.it.p).length_squared() > r * r
-                                || vp.depth + a.depth > max_depth + 2
-                            {
-                                continue;
-                            }
-                            let f = vp.bsdf.f(vp.wo, a.wi, TransportMode::Radiance);
-                            if f.is_black() {
-                                continue;
-                            }
-                            let ng = a.wi.dot(vp.n).abs();
-                            if ng == 0.0 {
-                                continue;
-                            }
-                            let correction = a.wi.dot(vp.shading_n).abs() / ng;
-                            let both = if pwl.secondary_terminated() {
-                                pwl
-                            } else {
-                                &vp.wl
-                            };
-                            let phi = rgb(vp.beta * f * a.beta * correction, both);
                             let s = &sums[i as usize];
                             for (sum, v) in s.phi.iter().zip([phi.r, phi.g, phi.b]) {
                                 let units = (v / UNIT).round();
@@ -244,6 +250,96 @@ pub fn render(
     }
 }
 
+/// The wavelengths of every path of one iteration: a golden-ratio sequence over the
+/// iterations, spectrally.
+fn iteration_wavelengths(settings: &RenderSettings, iteration: u32) -> SampledWavelengths {
+    match settings.integrator.color {
+        ColorMode::Spectral => {
+            let u0 = Rng::new(settings.seed, 0x5350_504d).uniform();
+            let u = (u0 + iteration as f64 * 0.618_033_988_749_894_9).fract();
+            SampledWavelengths::sample_visible(u)
+        }
+        ColorMode::Rgb => SampledWavelengths::rgb(),
+    }
+}
+
+/// Photon paths per iteration: the setting, or one per pixel.
+fn photons_per_iteration(settings: &RenderSettings) -> u64 {
+    match settings.integrator.photon.sppm_photons {
+        0 => settings.width as u64 * settings.height as u64,
+        n => n,
+    }
+}
+
+/// The ray tree of pixel (x, y) in SPPM's first iteration: its camera path to the visible
+/// point, and every photon of the first photon pass that landed within the pixel's radius
+/// there. The colour is the pixel's estimate after that one iteration.
+pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> (RayTree, Color) {
+    let camera = Camera::new(&scene.camera, settings.width, settings.height);
+    let wl = iteration_wavelengths(settings, 0);
+    let eye = Eye {
+        scene,
+        camera: &camera,
+        settings,
+        wl,
+        iteration: 0,
+    };
+    let mut px = PixelState::default();
+    let mut tree = RayTree::default();
+    let mut counts = RayCounts::default();
+    eye.camera_path(x, y, &mut px, &mut counts, Some(&mut tree));
+    let ld = Color::new(px.ld[0], px.ld[1], px.ld[2]);
+    let Some(vp) = px.vp else {
+        return (tree, ld);
+    };
+    let photons = photons_per_iteration(settings);
+    let tracer = PhotonTracer::new(scene, &settings.integrator);
+    let max_depth = settings.integrator.max_depth;
+    let chunks: Vec<Vec<(FoundPhoton, Color)>> = (0..photons.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|chunk| {
+            let (mut found, mut c) = (Vec::new(), RayCounts::default());
+            for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(photons) {
+                let mut stream = PhotonTracer::stream(settings.seed, 0, index);
+                let mut photon_wl = wl;
+                let time = camera.time(stream.next_1d());
+                tracer.trace(time, &mut photon_wl, &mut stream, &mut c, |a, pwl| {
+                    if a.depth >= 2 {
+                        if let Some(phi) = vp.photon_flux(px.radius, a, pwl, max_depth) {
+                            let photon = FoundPhoton {
+                                position: a.it.p,
+                                wi: a.wi,
+                                power: rgb(a.beta / photons as f64, pwl),
+                                distance: (a.it.p - vp.p).length(),
+                            };
+                            found.push((photon, phi));
+                        }
+                    }
+                    true
+                });
+            }
+            found
+        })
+        .collect();
+    let mut found: Vec<(FoundPhoton, Color)> = chunks.into_iter().flatten().collect();
+    found.sort_by(|a, b| a.0.distance.total_cmp(&b.0.distance));
+    let phi = found.iter().fold(Color::BLACK, |s, (_, f)| s + *f);
+    let estimate = phi * (1.0 / (photons as f64 * std::f64::consts::PI * px.radius * px.radius));
+    if let Some(node) = tree.nodes.last_mut() {
+        node.photons = Some(PhotonGather {
+            source: "SPPM photon pass",
+            radius: px.radius,
+            photons: found.into_iter().map(|(p, _)| p).collect(),
+            estimate,
+        });
+    }
+    let color = ld + estimate;
+    if let Some(root) = tree.nodes.first_mut() {
+        root.color = color;
+    }
+    (tree, color)
+}
+
 fn add_counts(mut a: RayCounts, b: RayCounts) -> RayCounts {
     a.add(&b);
     a
@@ -261,7 +357,14 @@ struct Eye<'a> {
 impl Eye<'_> {
     /// Traces pixel (x, y)'s camera path: adds the light it finds to `px.ld` and leaves its
     /// visible point in `px.vp`.
-    fn camera_path(&self, x: u32, y: u32, px: &mut PixelState, counts: &mut RayCounts) {
+    fn camera_path(
+        &self,
+        x: u32,
+        y: u32,
+        px: &mut PixelState,
+        counts: &mut RayCounts,
+        mut tree: Option<&mut RayTree>,
+    ) {
         let scene = self.scene;
         let s = self.settings;
         let mut stream = s.sampler.stream(s.seed, x, y, self.iteration);
@@ -277,12 +380,28 @@ impl Eye<'_> {
         let mut beta = SampledSpectrum::ONE;
         let mut distance = 0.0;
         let max_depth = s.integrator.max_depth;
+        let (mut kind, mut parent) = (RayKind::Camera, None);
         for e in 1..=max_depth + 1 {
+            let node = tree.as_deref_mut().map(|t| {
+                let weight = rgb(beta, &wl);
+                t.push(RayNode::new(
+                    parent,
+                    kind,
+                    e - 1,
+                    ray.origin,
+                    ray.direction,
+                    weight,
+                ))
+            });
+            parent = node;
             let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
                 l += beta * escaped(scene, ray.direction.normalized(), &wl, true);
+                record(&mut tree, node, |n| n.stops.push(Stop::Miss));
                 break;
             };
-            distance += hit.t * ray.direction.length();
+            let t = hit.t * ray.direction.length();
+            distance += t;
+            record_hit(&mut tree, node, scene, prim, t);
             let it = scene.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
             l += beta * emitted(scene, prim, &it, wo, &wl);
@@ -326,8 +445,10 @@ impl Eye<'_> {
             beta *= bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
             if bs.is_transmission() {
                 counts.refraction += 1;
+                kind = RayKind::Refracted;
             } else {
                 counts.reflection += 1;
+                kind = RayKind::Reflected;
             }
             if beta.is_black() {
                 break;
@@ -336,6 +457,11 @@ impl Eye<'_> {
                 Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(ray.time);
         }
         let c = rgb(l, &wl);
+        if let Some(t) = tree {
+            if let Some(root) = t.nodes.first_mut() {
+                root.color = c;
+            }
+        }
         if l.is_finite() && c.r.is_finite() && c.g.is_finite() && c.b.is_finite() {
             px.ld[0] += c.r;
             px.ld[1] += c.g;
