@@ -528,11 +528,15 @@ fn run_render(args: RenderArgs) -> ExitCode {
             eprintln!("error: --write-strategies needs --integrator bdpt");
             return ExitCode::from(2);
         }
+        settings.integrator.strategies = true;
+        if let Err(e) = settings.check() {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
         if let Err(e) = std::fs::create_dir_all(dir) {
             eprintln!("error: cannot make {}: {e}", dir.display());
             return ExitCode::from(1);
         }
-        settings.integrator.strategies = true;
     }
     if let Err(e) = plenum_image::OutputFormat::from_path(&args.output) {
         eprintln!("error: {e}");

@@ -555,6 +555,17 @@ fn photon_flags_are_checked() {
             &["--integrator", "sppm", "--filter", "gaussian"][..],
             "box filter",
         ),
+        (
+            &[
+                "--integrator",
+                "bdpt",
+                "--filter",
+                "gaussian",
+                "--write-strategies",
+                "strategies-never-written",
+            ][..],
+            "box filter",
+        ),
     ] {
         let o = run(args);
         assert_eq!(o.status.code(), Some(2), "{args:?}");

@@ -112,6 +112,9 @@ pub struct Camera {
     /// The image's size in pixels.
     width: f64,
     height: f64,
+    /// How far outside the image (in pixels) light paths still reach it: a pixel filter
+    /// wider than a pixel spreads their splats that far in.
+    margin: f64,
 }
 
 impl Camera {
@@ -125,7 +128,14 @@ impl Camera {
             pixel_size: 2.0 * half_height / height as f64,
             width: width as f64,
             height: height as f64,
+            margin: 0.0,
         }
+    }
+
+    /// The camera whose importance reaches `margin` pixels beyond the image's edges.
+    pub fn with_margin(mut self, margin: f64) -> Camera {
+        self.margin = margin;
+        self
     }
 
     /// The ray through raster position (x, y) from the lens centre at time 0: (0, 0) is the
@@ -283,7 +293,8 @@ impl Camera {
         let d = (f - frame.position) / focus;
         let x = (d.dot(frame.right) + self.half_width) / self.pixel_size;
         let y = (self.half_height - d.dot(frame.up)) / self.pixel_size;
-        (x >= 0.0 && y >= 0.0 && x < self.width && y < self.height).then_some([x, y])
+        let m = self.margin;
+        (x >= -m && y >= -m && x < self.width + m && y < self.height + m).then_some([x, y])
     }
 
     /// The direction through raster (x, y), with unit length along the view direction.

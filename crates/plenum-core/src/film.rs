@@ -12,6 +12,7 @@
 //! range add up to the sums of the whole.
 
 use crate::color::Color;
+use crate::sampling::Filter;
 use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
 
 #[derive(Clone, Debug)]
@@ -111,6 +112,9 @@ pub struct SplatBuffer {
     width: u32,
     height: u32,
     scale: f64,
+    /// The pixel filter splats are spread by, and 1 / its integral; None: the box of one
+    /// pixel, each splat in the pixel it lands in.
+    filter: Option<(Filter, f64)>,
     sums: Vec<[AtomicI64; 3]>,
     /// Splats too large for the fixed point, clamped.
     clamped: AtomicU64,
@@ -127,19 +131,65 @@ impl SplatBuffer {
             width,
             height,
             scale,
+            filter: None,
             sums: (0..n).map(|_| Default::default()).collect(),
             clamped: AtomicU64::new(0),
         }
     }
 
-    /// Adds `c` × the buffer's scale to the pixel that raster point `p` falls in (a box
-    /// filter); points off the film and values that are not finite are dropped.
+    /// Spreads each splat over the pixels within `filter`'s radius, pixel (i, j) taking
+    /// f(p − its centre) / ∫∫f of it (pbrt-v4's `RGBFilm::AddSplat`, normalised): the
+    /// estimate of the same filtered pixel that camera samples drawn from the filter make.
+    pub fn with_filter(mut self, filter: &Filter) -> SplatBuffer {
+        if *filter != Filter::box_pixel() {
+            self.filter = Some((filter.clone(), 1.0 / filter.integral()));
+        }
+        self
+    }
+
+    /// How far outside the image (in pixels) a splat can still reach a pixel.
+    pub fn margin(&self) -> f64 {
+        self.filter
+            .as_ref()
+            .map_or(0.0, |(f, _)| (f.radius() - 0.5).max(0.0))
+    }
+
+    /// Adds `c` × the buffer's scale at raster point `p`: to the pixel it falls in, or
+    /// spread by the filter; what lands off the film and values that are not finite are
+    /// dropped.
     pub fn add(&self, p: [f64; 2], c: Color) {
         let [px, py] = p;
-        if !(px >= 0.0 && py >= 0.0 && px < self.width as f64 && py < self.height as f64) {
+        let Some((filter, norm)) = &self.filter else {
+            if px >= 0.0 && py >= 0.0 && px < self.width as f64 && py < self.height as f64 {
+                self.add_to(py as usize * self.width as usize + px as usize, c);
+            }
+            return;
+        };
+        let r = filter.radius();
+        // Pixels whose centre (i + ½, j + ½) lies within r of p.
+        let range = |v: f64, n: u32| {
+            let lo = (v - 0.5 - r).ceil().max(0.0);
+            let hi = (v - 0.5 + r).floor().min(n as f64 - 1.0);
+            (lo as i64)..=(hi as i64)
+        };
+        if !(px.is_finite() && py.is_finite()) {
             return;
         }
-        let i = py as usize * self.width as usize + px as usize;
+        for j in range(py, self.height) {
+            let fy = filter.profile(py - (j as f64 + 0.5));
+            if fy == 0.0 {
+                continue;
+            }
+            for i in range(px, self.width) {
+                let w = fy * filter.profile(px - (i as f64 + 0.5)) * norm;
+                if w != 0.0 {
+                    self.add_to(j as usize * self.width as usize + i as usize, c * w);
+                }
+            }
+        }
+    }
+
+    fn add_to(&self, i: usize, c: Color) {
         for (sum, v) in self.sums[i].iter().zip([c.r, c.g, c.b]) {
             let units = (v * self.scale / Self::UNIT).round();
             if !units.is_finite() || units == 0.0 {
@@ -177,6 +227,53 @@ mod tests {
         assert_eq!(film.get(1, 0), Color::gray(1.5));
         assert_eq!(film.get(0, 1), Color::gray(0.5));
         assert_eq!(film.get(1, 1), Color::BLACK);
+    }
+
+    /// A filtered splat spreads over the pixels within the filter's radius with weights
+    /// f / ∫∫f: averaged over where in a pixel it lands (a 64×64 grid of points), they sum to
+    /// 1 within 10⁻³ for every filter, and a splat in the middle of a pixel gives that pixel
+    /// f(0, 0) / ∫∫f.
+    #[test]
+    fn filtered_splats_keep_their_total() {
+        use crate::sampling::FilterKind;
+        for kind in [
+            FilterKind::Box,
+            FilterKind::Tent,
+            FilterKind::Gaussian,
+            FilterKind::Mitchell,
+            FilterKind::Lanczos,
+        ] {
+            let filter = Filter::new(kind, kind.default_radius().max(0.75)).unwrap();
+            let buffer = SplatBuffer::new(9, 9, 1.0).with_filter(&filter);
+            let n = 64;
+            for j in 0..n {
+                for i in 0..n {
+                    let p = [
+                        4.0 + (i as f64 + 0.5) / n as f64,
+                        4.0 + (j as f64 + 0.5) / n as f64,
+                    ];
+                    buffer.add(p, Color::gray(1.0 / (n * n) as f64));
+                }
+            }
+            let mut film = Film::new(9, 9);
+            film.add_splats(&buffer);
+            film.resolve(1.0);
+            let total: f64 = film.pixels().iter().map(|p| p[0] as f64).sum();
+            assert!((total - 1.0).abs() < 1e-3, "{}: total {total}", kind.name());
+
+            let centre = SplatBuffer::new(9, 9, 1.0).with_filter(&filter);
+            centre.add([4.5, 4.5], Color::gray(1.0));
+            let mut film = Film::new(9, 9);
+            film.add_splats(&centre);
+            film.resolve(1.0);
+            let expected = filter.evaluate(0.0, 0.0) / filter.integral();
+            let got = film.get(4, 4).r;
+            assert!(
+                (got - expected).abs() < 1e-6,
+                "{}: {got} for {expected}",
+                kind.name()
+            );
+        }
     }
 
     /// The fixed-point sums do not depend on the order of the splats.

@@ -79,8 +79,8 @@ impl RenderSettings {
                     "integrator `{name}` cannot trace the SPD pixel corners (--nff-corners)"
                 ));
             }
-            if self.filter != Filter::default() {
-                return Err(format!("integrator `{name}` splats light paths onto pixels with the box filter of one pixel; other filters are not available with it"));
+            if self.integrator.strategies && self.filter != Filter::default() {
+                return Err("--write-strategies needs the box filter of one pixel: a strategy image takes each contribution where it lands".to_string());
             }
         }
         Ok(())
@@ -136,14 +136,17 @@ pub fn render(
     if settings.integrator.kind == IntegratorKind::Sppm {
         return crate::integrator::sppm::render(scene, settings, cancel, progress);
     }
-    let camera = Camera::new(&scene.camera, settings.width, settings.height);
-    // Splats are pixel values once divided by the light paths per pixel.
+    // Splats are pixel values once divided by the light paths per pixel; the camera's
+    // importance reaches as far beyond the image as the filter spreads them.
     let splats = if settings.integrator.kind.splats() {
         let spp = settings.sampler.samples_per_pixel().max(1);
         SplatBuffer::new(settings.width, settings.height, 1.0 / spp as f64)
+            .with_filter(&settings.filter)
     } else {
         SplatBuffer::new(0, 0, 0.0)
     };
+    let camera =
+        Camera::new(&scene.camera, settings.width, settings.height).with_margin(splats.margin());
     let strategies = (settings.integrator.strategies
         && settings.integrator.kind == IntegratorKind::Bdpt)
         .then(|| {
@@ -602,8 +605,10 @@ pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> 
     if settings.integrator.kind == IntegratorKind::Sppm {
         return crate::integrator::sppm::trace_pixel(scene, settings, x, y);
     }
-    let camera = Camera::new(&scene.camera, settings.width, settings.height);
-    let splats = SplatBuffer::new(settings.width, settings.height, 1.0);
+    let splats =
+        SplatBuffer::new(settings.width, settings.height, 1.0).with_filter(&settings.filter);
+    let camera =
+        Camera::new(&scene.camera, settings.width, settings.height).with_margin(splats.margin());
     let integrator = Integrator::new(
         scene,
         &settings.integrator,

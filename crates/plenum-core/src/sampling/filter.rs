@@ -173,6 +173,34 @@ impl Filter {
         self.profile(x) * self.profile(y)
     }
 
+    /// ∫∫ f over the plane, in pixels²: what a splat's weights are divided by, so that the
+    /// weights a splat gives the pixels around it sum to 1 (on average over its position).
+    pub fn integral(&self) -> f64 {
+        let r = self.radius;
+        let one_d = match self.kind {
+            FilterKind::Box => 2.0 * r,
+            FilterKind::Tent => r,
+            // Simpson's rule on 4096 intervals: the profiles are smooth within [−r, r].
+            _ => {
+                let n = 4096;
+                let h = 2.0 * r / n as f64;
+                let sum: f64 = (0..=n)
+                    .map(|i| {
+                        let w = match i {
+                            0 => 1.0,
+                            i if i == n => 1.0,
+                            i if i % 2 == 1 => 4.0,
+                            _ => 2.0,
+                        };
+                        w * self.profile(-r + h * i as f64)
+                    })
+                    .sum();
+                sum * h / 3.0
+            }
+        };
+        one_d * one_d
+    }
+
     /// The 1-D profile f₁ at offset `x` pixels.
     pub fn profile(&self, x: f64) -> f64 {
         let r = self.radius;

@@ -174,27 +174,8 @@ pub fn cbox_z_test_with(
         })
         .collect();
     assert_eq!(images[0].len(), reference.len());
-    let n = (reference.len() * 3) as f64;
-    let alpha = 1.0 - 0.99f64.powf(1.0 / n);
-    let z_max = normal_quantile(1.0 - alpha / 2.0);
-    let (mut pass, mut squared, mut predicted) = (0usize, 0.0, 0.0);
-    for i in 0..reference.len() {
-        for c in 0..3 {
-            let xs: Vec<f64> = images.iter().map(|im| im[i][c] as f64).collect();
-            let m = xs.iter().sum::<f64>() / renders as f64;
-            let var =
-                xs.iter().map(|x| (x - m).powi(2)).sum::<f64>() / ((renders - 1) * renders) as f64;
-            let d = m - reference[i][c] as f64;
-            let total = var + ref_var[i][c] as f64;
-            if total == 0.0 && d == 0.0 || d.abs() <= z_max * total.sqrt() {
-                pass += 1;
-            }
-            squared += d * d;
-            predicted += total;
-        }
-    }
-    let rate = pass as f64 / n;
-    let ratio = squared / predicted;
+    let (mean, var) = mean_and_variance(&images);
+    let (rate, ratio, z_max) = z_test(&mean, &var, &reference, &ref_var);
     eprintln!(
         "Cornell box, {}, {color:?}, {} spp: {:.4} % of pixel channels pass (z ≤ {z_max:.2}); squared error / predicted = {ratio:.3}",
         kind.name(),
@@ -206,6 +187,53 @@ pub fn cbox_z_test_with(
         (0.8..=1.25).contains(&ratio),
         "squared error is {ratio} × what noise predicts"
     );
+}
+
+/// Each pixel channel's mean over independent `images` and the variance of that mean.
+pub fn mean_and_variance(images: &[Vec<[f32; 3]>]) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    let k = images.len() as f64;
+    let n = images[0].len();
+    let mut mean = vec![[0.0; 3]; n];
+    let mut var = vec![[0.0; 3]; n];
+    for i in 0..n {
+        for c in 0..3 {
+            let m = images.iter().map(|im| im[i][c] as f64).sum::<f64>() / k;
+            let v = images
+                .iter()
+                .map(|im| (im[i][c] as f64 - m).powi(2))
+                .sum::<f64>();
+            mean[i][c] = m;
+            var[i][c] = v / ((k - 1.0) * k);
+        }
+    }
+    (mean, var)
+}
+
+/// Mitsuba 3's per-pixel z-test of estimate `a` (variance `va`) against `b` (variance `vb`):
+/// z = |a − b| / √(va + vb), a channel passing when 2(1 − Φ(z)) > α = 1 − 0.99^(1/N). Gives
+/// the fraction that pass, the squared error over what the variances predict, and z's bound.
+pub fn z_test<A: Copy + Into<f64>, B: Copy + Into<f64>>(
+    a: &[[f64; 3]],
+    va: &[[f64; 3]],
+    b: &[[A; 3]],
+    vb: &[[B; 3]],
+) -> (f64, f64, f64) {
+    let n = (a.len() * 3) as f64;
+    let alpha = 1.0 - 0.99f64.powf(1.0 / n);
+    let z_max = normal_quantile(1.0 - alpha / 2.0);
+    let (mut pass, mut squared, mut predicted) = (0usize, 0.0, 0.0);
+    for i in 0..a.len() {
+        for c in 0..3 {
+            let d = a[i][c] - b[i][c].into();
+            let total = va[i][c] + vb[i][c].into();
+            if total == 0.0 && d == 0.0 || d.abs() <= z_max * total.sqrt() {
+                pass += 1;
+            }
+            squared += d * d;
+            predicted += total;
+        }
+    }
+    (pass as f64 / n, squared / predicted, z_max)
 }
 
 /// Φ⁻¹(p) by bisection on the complementary error function's series (erfc from
