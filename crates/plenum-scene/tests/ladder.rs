@@ -81,12 +81,15 @@ fn every_method_cuts_paths_at_the_same_depth() {
 /// Every physically based method converges in a furnace with every sampler (their random
 /// numbers feed the light paths too): the sphere lit by its own emission 0.5, radiance 1
 /// everywhere; 256 samples (SPPM: iterations) per pixel, light tracing 1024, RGB, seed 11;
-/// each image mean within ±0.01 of 1 (photon mapping, biased, ±0.02).
+/// each image mean within ±0.01 of 1 (photon mapping, biased, ±0.02). Light tracing refuses
+/// `cook16`, whose fixed pairing of regions, the same in every pixel, tied its light paths'
+/// choices together across the image (0.87 for 1).
 #[test]
 fn every_method_converges_with_every_sampler() {
     use plenum_core::sampling::{PixelSampler, SamplerKind};
     let (_, _, emission) = &furnace_cases()[2];
     let l = scene(&furnace("", emission));
+    let mut failures = Vec::new();
     for sampler in [
         SamplerKind::Grid,
         SamplerKind::Random,
@@ -108,17 +111,22 @@ fn every_method_converges_with_every_sampler() {
             };
             let mut s = settings_for(&l, kind, spp, ColorMode::Rgb, 11);
             s.sampler = PixelSampler::new(sampler, spp);
+            if kind == IntegratorKind::Light && sampler == SamplerKind::Cook16 {
+                // Refused: Cook's one table for every pixel would bias light paths.
+                assert!(s.check().unwrap_err().contains("cook16"));
+                continue;
+            }
             let m = mean(&draw(&l, &s));
-            for (c, v) in m.iter().enumerate() {
-                assert!(
-                    (v - 1.0).abs() <= tolerance,
-                    "{} with the {} sampler: channel {c} has mean {v}, expected 1 ± {tolerance}",
+            if m.iter().any(|v| (v - 1.0).abs() > tolerance) {
+                failures.push(format!(
+                    "{} with the {} sampler: mean {m:?}, expected 1 ± {tolerance}",
                     kind.name(),
                     sampler.name()
-                );
+                ));
             }
         }
     }
+    assert!(failures.is_empty(), "{failures:#?}");
 }
 
 #[test]
