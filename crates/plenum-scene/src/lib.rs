@@ -2,6 +2,7 @@
 //! with located diagnostics and built into a core [`plenum_core::scene::Scene`].
 
 pub mod diagnostics;
+mod limits;
 mod model;
 mod mtl;
 mod native;
