@@ -517,6 +517,12 @@ fn run_render(args: RenderArgs) -> ExitCode {
             defaults,
             warnings,
         };
+        for what in loaded.scene.capped_structures() {
+            eprintln!(
+                "warning: the {} over {what} reached its memory bound (items that overlap many cells); it is kept coarser there, and slower",
+                args.accel
+            );
+        }
     }
     let load_seconds = load_start.elapsed().as_secs_f64();
     let mut settings = match settings(&args.view, &mut loaded) {
