@@ -12,6 +12,7 @@ mod ply;
 mod ray;
 pub mod ray_files;
 mod reader;
+mod text;
 mod writer;
 
 pub use writer::to_toml;
@@ -92,7 +93,7 @@ pub fn load_mesh(path: &Path) -> Result<plenum_core::geometry::TriangleMesh, Sce
     match extension.as_str() {
         "ply" => ply::load_ply(path),
         "obj" => {
-            let text = std::fs::read_to_string(path)
+            let (text, _) = text::read_lenient(path)
                 .map_err(|e| SceneError::file(path, format!("cannot read the mesh file: {e}")))?;
             let mut model = obj::parse_obj_model(path, &text, false)?;
             Ok(model.groups.remove(0).1)
@@ -118,29 +119,33 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
         // Binary: not read as text.
         return model::load_model(path, &extension);
     }
-    let text = std::fs::read_to_string(path)
+    if extension == "obj" {
+        return model::load_model(path, &extension);
+    }
+    let (text, not_utf8) = text::read_lenient(path)
         .map_err(|e| SceneError::file(path, format!("cannot read the scene file: {e}")))?;
     let base = path.parent().unwrap_or(Path::new("."));
-    match extension.as_str() {
+    let mut loaded = match extension.as_str() {
         "nff" => {
             let (builder, defaults) = nff::parse(path, &text)?;
-            Ok(LoadedScene {
+            LoadedScene {
                 scene: builder.build(),
                 defaults,
                 warnings: Vec::new(),
-            })
+            }
         }
         "ray" => {
             let (builder, defaults, warnings) = ray::parse(path, &text, base)?;
-            Ok(LoadedScene {
+            LoadedScene {
                 scene: builder.build(),
                 defaults,
                 warnings,
-            })
+            }
         }
-        "obj" | "ply" => model::load_model(path, &extension),
-        _ => parse_scene(path, &text, base),
-    }
+        _ => parse_scene(path, &text, base)?,
+    };
+    loaded.warnings.splice(0..0, not_utf8);
+    Ok(loaded)
 }
 
 /// Parses native scene text; `path` names it in messages, `base_dir` resolves relative paths.

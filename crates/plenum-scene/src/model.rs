@@ -25,15 +25,17 @@ pub fn load_model(path: &Path, extension: &str) -> Result<LoadedScene, SceneErro
     let groups: Vec<(String, PhongMaterial, TriangleMesh)> = if extension == "ply" {
         vec![("model".into(), default_material(), ply::load_ply(path)?)]
     } else {
-        let text = std::fs::read_to_string(path)
+        let (text, not_utf8) = crate::text::read_lenient(path)
             .map_err(|e| SceneError::file(path, format!("cannot read the mesh file: {e}")))?;
+        warnings.extend(not_utf8);
         let model = obj::parse_obj_model(path, &text, true)?;
         warnings.extend(model.warnings.iter().cloned());
         let mut materials: HashMap<String, PhongMaterial> = HashMap::new();
         for lib in &model.material_libraries {
             let lib_path = base.join(lib);
-            match std::fs::read_to_string(&lib_path) {
-                Ok(t) => {
+            match crate::text::read_lenient(&lib_path) {
+                Ok((t, not_utf8)) => {
+                    warnings.extend(not_utf8);
                     let (m, w) = mtl::parse_mtl(&lib_path, &t, lib_path.parent().unwrap_or(base))?;
                     materials.extend(m);
                     warnings.extend(w);
