@@ -91,7 +91,7 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<TriangleMesh, SceneError> 
     parse_ply_with(path, bytes, false)
 }
 
-fn parse_ply_with(
+pub(crate) fn parse_ply_with(
     path: &Path,
     bytes: &[u8],
     keep_indices: bool,
