@@ -6,6 +6,7 @@
 mod bench;
 #[cfg(feature = "embree")]
 mod embree;
+mod memory;
 mod trace;
 
 use clap::{Args, Parser, Subcommand};
@@ -157,10 +158,11 @@ struct RenderArgs {
     output: PathBuf,
     #[command(flatten)]
     view: ViewArgs,
-    /// Worker threads (default: all cores). The image does not depend on it.
+    /// Worker threads (default, or 0: all cores; at most 1024). The image does not depend
+    /// on it.
     #[arg(long)]
     threads: Option<usize>,
-    /// Exposure in stops, for PNG output.
+    /// Exposure in stops, for PNG output (−64 to 64).
     #[arg(long)]
     exposure: Option<f64>,
     /// Acceleration structure: bvh (default), grid, octree or none (brute force).
@@ -277,6 +279,27 @@ impl std::fmt::Display for SamplerArg {
 }
 
 static CANCEL: AtomicBool = AtomicBool::new(false);
+
+/// Most worker threads `--threads` takes: far more than any machine's cores, far fewer than
+/// would exhaust the system's threads or memory for their stacks.
+const MAX_THREADS: usize = 1024;
+/// Largest exposure in stops, either way: 2^64 is beyond any image's range.
+const MAX_EXPOSURE: f64 = 64.0;
+
+/// Whether `path` can be written, by opening it for writing as the image will be (without
+/// truncating it), and removing it again if it did not exist.
+fn check_writable(path: &Path) -> Result<(), std::io::Error> {
+    let existed = path.exists();
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(path)?;
+    if !existed {
+        let _ = std::fs::remove_file(path);
+    }
+    Ok(())
+}
 
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
@@ -517,6 +540,12 @@ fn run_render(args: RenderArgs) -> ExitCode {
             defaults,
             warnings,
         };
+        for what in loaded.scene.capped_structures() {
+            eprintln!(
+                "warning: the {} over {what} reached its memory bound (items that overlap many cells); it is kept coarser there, and slower",
+                args.accel
+            );
+        }
     }
     let load_seconds = load_start.elapsed().as_secs_f64();
     let mut settings = match settings(&args.view, &mut loaded) {
@@ -542,7 +571,42 @@ fn run_render(args: RenderArgs) -> ExitCode {
         eprintln!("error: {e}");
         return ExitCode::from(2);
     }
+    // Found now, not after the whole render.
+    if let Err(e) = check_writable(&args.output) {
+        eprintln!("error: cannot write {}: {e}", args.output.display());
+        return ExitCode::from(2);
+    }
+    let exposure = args.exposure.unwrap_or(loaded.defaults.exposure);
+    if exposure.is_nan() || exposure.abs() > MAX_EXPOSURE {
+        eprintln!("error: --exposure must be a number of stops between -{MAX_EXPOSURE} and {MAX_EXPOSURE}, not {exposure}");
+        return ExitCode::from(2);
+    }
+    let exposure = exposure as f32;
+    let strategy_images = if settings.integrator.strategies {
+        let d = settings.integrator.max_depth as usize;
+        (d + 2) * (d + 3) / 2
+    } else {
+        0
+    };
+    let per_pixel = memory::bytes_per_pixel(
+        settings.integrator.kind,
+        settings.adaptive.is_some(),
+        strategy_images,
+    );
+    if let Err(e) = memory::check(
+        settings.width,
+        settings.height,
+        per_pixel,
+        memory::available(),
+    ) {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
     let threads = args.threads.unwrap_or(0);
+    if threads > MAX_THREADS {
+        eprintln!("error: --threads must be at most {MAX_THREADS} (0: all cores), not {threads}");
+        return ExitCode::from(2);
+    }
     let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
         Ok(p) => p,
         Err(e) => {
@@ -579,7 +643,6 @@ fn run_render(args: RenderArgs) -> ExitCode {
     let elapsed = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
-    let exposure = args.exposure.unwrap_or(loaded.defaults.exposure) as f32;
     let film = &output.film;
     if let Err(e) = plenum_image::write_image(
         &args.output,

@@ -587,3 +587,55 @@ fn photon_flags_are_checked() {
         assert!(o.status.success(), "{method}: {}", stderr(&o));
     }
 }
+
+#[test]
+fn bad_options_and_outputs_are_refused_before_rendering() {
+    let tmp = temp_dir("refused");
+    let dir = tmp.path();
+    let out = dir.join("out.png");
+    let refused = |args: &[&str], what: &str| {
+        let o = plenum().arg("render").args(args).output().unwrap();
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(what), "{args:?}: {}", stderr(&o));
+    };
+    let missing = dir.join("no-such-folder/out.png");
+    // Before, found only after the render, with exit code 1.
+    refused(
+        &[
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "-o",
+            missing.to_str().unwrap(),
+        ],
+        "cannot write",
+    );
+    let o = out.to_str().unwrap();
+    refused(&["--exposure", "nan", "-o", o], "--exposure");
+    refused(&["--exposure", "1e300", "-o", o], "--exposure");
+    refused(&["--threads", "100000", "-o", o], "--threads");
+    // Nothing was left behind by the checks.
+    assert!(!out.exists());
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn an_image_larger_than_memory_is_refused_before_rendering() {
+    // The largest size accepted, under a 2 GB address-space limit: it aborted when the film
+    // could not be allocated; now it is refused at once.
+    let tmp = temp_dir("memory");
+    let out = tmp.path().join("big.png");
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 2000000 && exec '{}' render --width 16384 --height 16384 -o '{}'",
+            env!("CARGO_BIN_EXE_plenum"),
+            out.display()
+        ))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("needs about"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("ulimit -v"), "{}", stderr(&o));
+}

@@ -298,6 +298,25 @@ impl Scene {
         self.accel.kind()
     }
 
+    /// The structures that had to bound their cells' references (see `Grid::capped`,
+    /// `Octree::capped`), named for a warning: "the scene's primitives" or the objects whose
+    /// mesh it is.
+    pub fn capped_structures(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.accel.capped() {
+            out.push("the scene's primitives".to_string());
+        }
+        let mut seen = std::collections::HashSet::new();
+        for (p, name) in self.primitives.iter().zip(&self.object_names) {
+            if let Shape::Mesh(m) = &p.shape {
+                if seen.insert(Arc::as_ptr(m)) && m.accel_capped() {
+                    out.push(format!("the triangles of `{name}`"));
+                }
+            }
+        }
+        out
+    }
+
     /// Bytes of the acceleration structures: the scene's and every distinct mesh's (with
     /// the mesh's vertices and indices).
     pub fn accel_memory_bytes(&self) -> usize {

@@ -2,6 +2,7 @@
 //! with located diagnostics and built into a core [`plenum_core::scene::Scene`].
 
 pub mod diagnostics;
+mod limits;
 mod model;
 mod mtl;
 mod native;
@@ -11,6 +12,7 @@ mod ply;
 mod ray;
 pub mod ray_files;
 mod reader;
+mod text;
 mod writer;
 
 pub use writer::to_toml;
@@ -91,7 +93,7 @@ pub fn load_mesh(path: &Path) -> Result<plenum_core::geometry::TriangleMesh, Sce
     match extension.as_str() {
         "ply" => ply::load_ply(path),
         "obj" => {
-            let text = std::fs::read_to_string(path)
+            let (text, _) = text::read_lenient(path)
                 .map_err(|e| SceneError::file(path, format!("cannot read the mesh file: {e}")))?;
             let mut model = obj::parse_obj_model(path, &text, false)?;
             Ok(model.groups.remove(0).1)
@@ -113,33 +115,50 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    if extension == "ply" {
-        // Binary: not read as text.
-        return model::load_model(path, &extension);
-    }
-    let text = std::fs::read_to_string(path)
+    let bytes = std::fs::read(path)
         .map_err(|e| SceneError::file(path, format!("cannot read the scene file: {e}")))?;
+    read_scene(path, &extension, bytes)
+}
+
+/// [`load_scene`] of a file's bytes already read: `extension` (lower case) chooses the reader,
+/// `path` names the file in messages and resolves relative paths inside. The fuzz targets
+/// call it.
+pub fn read_scene(path: &Path, extension: &str, bytes: Vec<u8>) -> Result<LoadedScene, SceneError> {
+    if extension == "obj" || extension == "ply" {
+        // PLY is binary, and OBJ is read leniently by the model's reader.
+        return model::model_from_bytes(path, extension, bytes);
+    }
+    let (text, not_utf8) = text::lenient(path, bytes);
     let base = path.parent().unwrap_or(Path::new("."));
-    match extension.as_str() {
+    let mut loaded = match extension {
         "nff" => {
             let (builder, defaults) = nff::parse(path, &text)?;
-            Ok(LoadedScene {
+            LoadedScene {
                 scene: builder.build(),
                 defaults,
                 warnings: Vec::new(),
-            })
+            }
         }
         "ray" => {
             let (builder, defaults, warnings) = ray::parse(path, &text, base)?;
-            Ok(LoadedScene {
+            LoadedScene {
                 scene: builder.build(),
                 defaults,
                 warnings,
-            })
+            }
         }
-        "obj" | "ply" => model::load_model(path, &extension),
-        _ => parse_scene(path, &text, base),
-    }
+        _ => parse_scene(path, &text, base)?,
+    };
+    loaded.warnings.splice(0..0, not_utf8);
+    Ok(loaded)
+}
+
+/// An MTL material library's bytes, read as an OBJ's `mtllib` is; the number of materials.
+/// For the fuzz targets: MTL files are otherwise read only through an OBJ.
+pub fn read_material_library(path: &Path, bytes: Vec<u8>) -> Result<usize, SceneError> {
+    let (text, _) = text::lenient(path, bytes);
+    let base = path.parent().unwrap_or(Path::new("."));
+    mtl::parse_mtl(path, &text, base).map(|(materials, _)| materials.len())
 }
 
 /// Parses native scene text; `path` names it in messages, `base_dir` resolves relative paths.

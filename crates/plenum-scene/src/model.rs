@@ -18,22 +18,28 @@ use std::sync::Arc;
 /// Field of view of the framing camera, in degrees.
 const FOV: f64 = 35.0;
 
-/// Loads a mesh file as a whole scene.
-pub fn load_model(path: &Path, extension: &str) -> Result<LoadedScene, SceneError> {
+/// A mesh file's bytes as a whole scene; `path` names it and locates its material libraries.
+pub fn model_from_bytes(
+    path: &Path,
+    extension: &str,
+    bytes: Vec<u8>,
+) -> Result<LoadedScene, SceneError> {
     let base = path.parent().unwrap_or(Path::new("."));
     let mut warnings = Vec::new();
     let groups: Vec<(String, PhongMaterial, TriangleMesh)> = if extension == "ply" {
-        vec![("model".into(), default_material(), ply::load_ply(path)?)]
+        let mesh = ply::parse_ply_with(path, &bytes, false)?;
+        vec![("model".into(), default_material(), mesh)]
     } else {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SceneError::file(path, format!("cannot read the mesh file: {e}")))?;
+        let (text, not_utf8) = crate::text::lenient(path, bytes);
+        warnings.extend(not_utf8);
         let model = obj::parse_obj_model(path, &text, true)?;
         warnings.extend(model.warnings.iter().cloned());
         let mut materials: HashMap<String, PhongMaterial> = HashMap::new();
         for lib in &model.material_libraries {
             let lib_path = base.join(lib);
-            match std::fs::read_to_string(&lib_path) {
-                Ok(t) => {
+            match crate::text::read_lenient(&lib_path) {
+                Ok((t, not_utf8)) => {
+                    warnings.extend(not_utf8);
                     let (m, w) = mtl::parse_mtl(&lib_path, &t, lib_path.parent().unwrap_or(base))?;
                     materials.extend(m);
                     warnings.extend(w);

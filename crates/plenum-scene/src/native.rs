@@ -1228,7 +1228,8 @@ impl<'s> Reader<'s> {
             };
             return match extension.as_str() {
                 "obj" => {
-                    let text = std::fs::read_to_string(&path).map_err(unreadable)?;
+                    let (text, not_utf8) = crate::text::read_lenient(&path).map_err(unreadable)?;
+                    self.warnings.extend(not_utf8);
                     let mut model = obj::parse_obj_model_with(&path, &text, false, true)?;
                     self.warnings.append(&mut model.warnings);
                     Ok(Arc::new(model.groups.remove(0).1))

@@ -16,6 +16,7 @@
 //!   weight cut-off.
 
 use crate::diagnostics::SceneError;
+use crate::limits::check_count;
 use crate::RenderDefaults;
 use plenum_core::camera::CameraSettings;
 use plenum_core::color::Color;
@@ -131,7 +132,7 @@ pub fn parse(path: &Path, text: &str) -> Result<(SceneBuilder, RenderDefaults), 
                         builder.add_object(format!("cone {}", counts[1]), shape, frame, m);
                     }
                     "p" => {
-                        let n = p.count()?;
+                        let n = p.count(3)?;
                         let vertices = (0..n).map(|_| p.vec3()).collect::<Result<Vec<_>, _>>()?;
                         let polygon = Polygon::new(vertices)
                             .map_err(|e| p.error(span.start..p.last.end, e.to_string()))?;
@@ -144,7 +145,7 @@ pub fn parse(path: &Path, text: &str) -> Result<(SceneBuilder, RenderDefaults), 
                         );
                     }
                     _ => {
-                        let n = p.count()?;
+                        let n = p.count(6)?;
                         let mut corners = Vec::with_capacity(n);
                         for _ in 0..n {
                             corners.push((p.vec3()?, p.vec3()?));
@@ -309,12 +310,19 @@ impl<'s, I: Iterator<Item = (&'s str, Range<usize>)>> Parser<'s, I> {
         Ok(Color::new(r, g, b))
     }
 
-    fn count(&mut self) -> Result<usize, SceneError> {
+    /// A vertex count, each vertex `numbers` numbers, which the rest of the file must be
+    /// able to hold (each number is at least a separator and a digit).
+    fn count(&mut self, numbers: u64) -> Result<usize, SceneError> {
         let (t, span) = self.next("a vertex count")?;
-        t.parse::<usize>()
-            .ok()
-            .filter(|&n| n <= 1 << 20)
-            .ok_or_else(|| self.error(span, format!("expected a vertex count, found `{t}`")))
+        let n = t.parse::<u64>().map_err(|_| {
+            self.error(
+                span.clone(),
+                format!("expected a vertex count, found `{t}`"),
+            )
+        })?;
+        let remaining = self.text.len() - span.end;
+        check_count(n, 2 * numbers, remaining, "vertices").map_err(|e| self.error(span, e))?;
+        Ok(n as usize)
     }
 
     fn next_is_number(&mut self) -> bool {
@@ -451,8 +459,23 @@ mod tests {
         assert_eq!((e.line, e.column), (9, 7));
         let e = read(&format!("{VIEW}s 0 0 0 1\n")).unwrap_err();
         assert!(e.message.contains("`f` surface record"), "{}", e.message);
-        let e = read(&format!("{VIEW}f 1 1 1 1 0 0 0 0\np 4 0 0 0 1 0 0\n")).unwrap_err();
+        let e = read(&format!(
+            "{VIEW}f 1 1 1 1 0 0 0 0\np 3 0 0 0 1 0 0 1 1 # cut short\n"
+        ))
+        .unwrap_err();
         assert!(e.message.contains("end of the file"), "{}", e.message);
+        // A count the rest of the file cannot hold is refused at the count, before anything
+        // is allocated for it (this one asked for 48 MB).
+        let e = read(&format!(
+            "{VIEW}f 1 1 1 1 0 0 0 0\npp 1048576\n0 0 0 0 0 1\n"
+        ))
+        .unwrap_err();
+        assert_eq!((e.line, e.column), (9, 4));
+        assert!(
+            e.message.contains("asks for 1048576 vertices"),
+            "{}",
+            e.message
+        );
         let e = read(&format!("{VIEW}q 1\n")).unwrap_err();
         assert!(e.message.contains("unknown NFF record `q`"));
         let e = read("f 1 1 1 1 0 0 0 0\n").unwrap_err();

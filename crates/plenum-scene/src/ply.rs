@@ -5,6 +5,7 @@
 //! body, which has no lines, at the element and record.
 
 use crate::diagnostics::SceneError;
+use crate::limits::check_count;
 use plenum_core::geometry::TriangleMesh;
 use plenum_core::math::Vec3;
 use std::ops::Range;
@@ -58,8 +59,10 @@ struct Property {
 #[derive(Clone, Debug)]
 struct Element {
     name: String,
-    count: usize,
+    count: u64,
     properties: Vec<Property>,
+    /// Its `element` line in the header, for errors about the element as a whole.
+    line: Range<usize>,
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -88,7 +91,7 @@ pub fn parse_ply(path: &Path, bytes: &[u8]) -> Result<TriangleMesh, SceneError> 
     parse_ply_with(path, bytes, false)
 }
 
-fn parse_ply_with(
+pub(crate) fn parse_ply_with(
     path: &Path,
     bytes: &[u8],
     keep_indices: bool,
@@ -147,6 +150,7 @@ fn parse_ply_with(
                     name: name.into(),
                     count,
                     properties: Vec::new(),
+                    line: start..start + line.trim_end().len(),
                 });
             }
             "property" => {
@@ -186,6 +190,7 @@ fn parse_ply_with(
         _ => Box::new(Binary {
             path,
             data: body,
+            offset: body_start,
             pos: 0,
             big: format == Format::Big,
         }),
@@ -209,9 +214,36 @@ fn parse_ply_with(
             find(&["v", "t", "texture_v"]),
         );
         let indices = find(&["vertex_indices", "vertex_index"]);
+        let whole = |message: &str| at(element.line.clone(), message.to_string());
+        // Before looping over its records: an element's count must fit in what is left of
+        // the file, or a short file could ask for unbounded time.
+        let record_bytes: usize = element
+            .properties
+            .iter()
+            .map(|p| reader.least_bytes(p.list.unwrap_or(p.value)))
+            .sum();
+        if record_bytes == 0 {
+            // No properties: its records take no bytes and hold nothing.
+            match element.name.as_str() {
+                "vertex" if element.count > 0 => {
+                    return Err(whole("the vertex element lacks x, y or z"))
+                }
+                "face" if element.count > 0 => {
+                    return Err(whole("the face element has no vertex_indices list"))
+                }
+                _ => continue,
+            }
+        }
+        check_count(
+            element.count,
+            record_bytes as u64,
+            reader.remaining(),
+            &format!("`{}` records", element.name),
+        )
+        .map_err(|e| whole(&e))?;
         let mut record = vec![0.0; element.properties.len()];
         let mut list: Vec<f64> = Vec::new();
-        for r in 0..element.count {
+        for r in 0..element.count as usize {
             reader.start_record(&element.name, r)?;
             let mut face = None;
             for (i, p) in element.properties.iter().enumerate() {
@@ -222,6 +254,9 @@ fn parse_ply_with(
                         if !(0.0..=1e6).contains(&n) || n.fract() != 0.0 {
                             return Err(reader.error(format!("a list of {n} items")));
                         }
+                        let least = reader.least_bytes(p.value) as u64;
+                        check_count(n as u64, least, reader.remaining(), "list items")
+                            .map_err(|e| reader.error(e))?;
                         list.clear();
                         for _ in 0..n as usize {
                             list.push(reader.value(p.value)?);
@@ -234,7 +269,7 @@ fn parse_ply_with(
             }
             if element.name == "vertex" {
                 let (Some(x), Some(y), Some(z)) = (x, y, z) else {
-                    return Err(SceneError::file(path, "the vertex element lacks x, y or z"));
+                    return Err(whole("the vertex element lacks x, y or z"));
                 };
                 let p = Vec3::new(record[x], record[y], record[z]);
                 if !p.is_finite() {
@@ -248,9 +283,8 @@ fn parse_ply_with(
                     uvs.push([record[a], record[b]]);
                 }
             } else if element.name == "face" {
-                let face = face.ok_or_else(|| {
-                    SceneError::file(path, "the face element has no vertex_indices list")
-                })?;
+                let face =
+                    face.ok_or_else(|| whole("the face element has no vertex_indices list"))?;
                 if face.len() < 3 {
                     return Err(reader.error(format!(
                         "face {r} has {} vertices; at least 3 are needed",
@@ -305,6 +339,10 @@ fn words(line: &str, base: usize) -> Vec<(&str, Range<usize>)> {
 trait Values {
     fn start_record(&mut self, element: &str, index: usize) -> Result<(), SceneError>;
     fn value(&mut self, t: Scalar) -> Result<f64, SceneError>;
+    /// The fewest bytes a value of type `t` takes.
+    fn least_bytes(&self, t: Scalar) -> usize;
+    /// Bytes not read yet.
+    fn remaining(&self) -> usize;
     /// An error at the current place.
     fn error(&self, message: String) -> SceneError;
 }
@@ -333,6 +371,15 @@ impl<'a> Ascii<'a> {
 impl Values for Ascii<'_> {
     fn start_record(&mut self, _: &str, _: usize) -> Result<(), SceneError> {
         Ok(())
+    }
+
+    fn least_bytes(&self, _: Scalar) -> usize {
+        // A digit; the separator after it may be missing at the end of the file.
+        1
+    }
+
+    fn remaining(&self) -> usize {
+        self.text.len() - self.pos
     }
 
     fn value(&mut self, _: Scalar) -> Result<f64, SceneError> {
@@ -365,6 +412,8 @@ impl Values for Ascii<'_> {
 struct Binary<'a> {
     path: &'a Path,
     data: &'a [u8],
+    /// Where `data` starts in the file, for errors by byte offset.
+    offset: usize,
     pos: usize,
     big: bool,
 }
@@ -372,12 +421,19 @@ struct Binary<'a> {
 impl Values for Binary<'_> {
     fn start_record(&mut self, element: &str, index: usize) -> Result<(), SceneError> {
         if self.pos >= self.data.len() {
-            return Err(SceneError::file(
-                self.path,
-                format!("the file ends before {element} {index}: it is truncated"),
-            ));
+            return Err(self.error(format!(
+                "the file ends before {element} {index}: it is truncated"
+            )));
         }
         Ok(())
+    }
+
+    fn least_bytes(&self, t: Scalar) -> usize {
+        t.size()
+    }
+
+    fn remaining(&self) -> usize {
+        self.data.len() - self.pos
     }
 
     fn value(&mut self, t: Scalar) -> Result<f64, SceneError> {
@@ -406,7 +462,7 @@ impl Values for Binary<'_> {
     fn error(&self, message: String) -> SceneError {
         SceneError::file(
             self.path,
-            format!("at byte {} of the body: {message}", self.pos),
+            format!("at byte {}: {message}", self.offset + self.pos),
         )
     }
 }
@@ -492,5 +548,39 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.message.contains("end of the file"));
+    }
+
+    #[test]
+    fn counts_the_file_cannot_hold_are_refused_at_once() {
+        // An element of no properties and a count of 2^64 − 1 spun forever; so did one whose
+        // records a short body could never hold. Each is an error at its header line.
+        let junk = "ply\nformat ascii 1.0\nelement junk 18446744073709551615\nend_header\n";
+        assert!(parse_ply(Path::new("j.ply"), junk.as_bytes()).is_err());
+        let empty_face = "ply\nformat ascii 1.0\nelement face 18446744073709551615\nend_header\n";
+        let e = parse_ply(Path::new("f.ply"), empty_face.as_bytes()).unwrap_err();
+        assert_eq!(e.line, 3);
+        assert!(e.message.contains("no vertex_indices"), "{}", e.message);
+        for format in ["ascii", "binary_little_endian"] {
+            let text = format!(
+                "ply\nformat {format} 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n"
+            );
+            let e = parse_ply(Path::new("v.ply"), text.as_bytes()).unwrap_err();
+            assert_eq!((e.line, e.column), (3, 1), "{format}");
+            assert!(e.message.contains("asks for 4000000000"), "{}", e.message);
+        }
+        // A list longer than the rest of the file.
+        let text = HEADER
+            .replace("uchar int", "int int")
+            .replace("ascii", "binary_little_endian");
+        let mut bytes = text.clone().into_bytes();
+        bytes.extend([0u8; 48]);
+        bytes.extend(900_000i32.to_le_bytes());
+        let e = parse_ply(Path::new("l.ply"), &bytes).unwrap_err();
+        assert!(e.message.contains("list items"), "{}", e.message);
+        assert!(
+            e.message.contains(&format!("at byte {}", text.len() + 52)),
+            "{}",
+            e.message
+        );
     }
 }

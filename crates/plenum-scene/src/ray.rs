@@ -16,6 +16,7 @@
 //! resolution: 512 pixels wide, the height from the camera's aspect ratio.
 
 use crate::diagnostics::{did_you_mean, SceneError};
+use crate::limits::MAX_NESTING;
 use crate::RenderDefaults;
 use plenum_core::camera::CameraSettings;
 use plenum_core::color::Color;
@@ -70,6 +71,7 @@ pub fn parse(
         objects: 0,
         lights: 0,
         aspect: 1.0,
+        depth: 0,
     };
     p.builder.camera = CameraSettings {
         position: Vec3::ZERO,
@@ -130,6 +132,8 @@ struct Parser<'s> {
     objects: usize,
     lights: usize,
     aspect: f64,
+    /// Groups and transforms open around the current statement.
+    depth: usize,
 }
 
 impl<'s> Parser<'s> {
@@ -611,8 +615,22 @@ impl<'s> Parser<'s> {
         Ok(Texture::Image(Arc::new(image)))
     }
 
-    /// A primitive, a transform node or a `{ … }` group, placed by `to_world`.
+    /// A primitive, a transform node or a `{ … }` group, placed by `to_world`. Nesting is
+    /// bounded: each level is a call, and a file of thousands would overflow the stack.
     fn geometry(&mut self, to_world: Transform) -> Result<(), SceneError> {
+        if self.depth >= MAX_NESTING {
+            return Err(self.error(
+                self.span(),
+                format!("groups and transforms nest deeper than {MAX_NESTING} levels here"),
+            ));
+        }
+        self.depth += 1;
+        let placed = self.placed(to_world);
+        self.depth -= 1;
+        placed
+    }
+
+    fn placed(&mut self, to_world: Transform) -> Result<(), SceneError> {
         if self.eat('{') {
             while !self.eat('}') {
                 if self.eat(';') {
@@ -1214,5 +1232,30 @@ mod tests {
         let e = read("SBT-raytracer 1.0\ntrimesh { points = ((0,0,0),(1,0,0),(1,1,0)); faces = ((0,1,3)); }\n").unwrap_err();
         assert!(e.message.contains("out of range"));
         assert_eq!((e.line, e.column), (2, 61));
+    }
+
+    #[test]
+    fn deep_nesting_is_a_located_error_not_a_stack_overflow() {
+        // 100 000 levels overflowed the stack before nesting was bounded.
+        for (open, close) in [("translate(0,0,0,", ")"), ("{", "}")] {
+            let n = 100_000;
+            let text = format!(
+                "SBT-raytracer 1.0\nscale(1,{}sphere {{}}{})\n",
+                open.repeat(n),
+                close.repeat(n)
+            );
+            let e = read(&text).unwrap_err();
+            assert!(e.message.contains("deeper than 256"), "{}", e.message);
+            assert_eq!(e.line, 2);
+            assert_eq!(e.column, "scale(1,".len() + 255 * open.len() + 1);
+        }
+        // As deep as allowed still reads.
+        let text = format!(
+            "SBT-raytracer 1.0\n{}sphere {{}}{}\n",
+            "translate(1,0,0,".repeat(MAX_NESTING - 1),
+            ")".repeat(MAX_NESTING - 1)
+        );
+        let (scene, _, _) = read(&text).unwrap();
+        assert_eq!(scene.primitives.len(), 1);
     }
 }

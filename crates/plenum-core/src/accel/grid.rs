@@ -20,6 +20,12 @@ const LAMBDA: f64 = 1.5;
 /// tests cost less per item: 5–11 % faster than [`LAMBDA`] on the dragon's rays.
 const LAMBDA_BLOCKS: f64 = 0.75;
 const MAX_RESOLUTION: usize = 512;
+/// Most cell references per filed item (counted by boxes, before the finer test, which
+/// halves them on a flat mesh: 8.7 by box at its λN resolution), plus [`SPARE_REFERENCES`]. Items that overlap (6000 copies of one triangle) would otherwise
+/// each be filed in thousands of cells: 3.6 GB. Where the resolution would need more, it is
+/// coarsened until they fit, and the grid says so ([`Grid::capped`]).
+const REFERENCES_PER_ITEM: usize = 16;
+const SPARE_REFERENCES: usize = 1 << 12;
 /// Cells per macro cell along each axis (a power of two).
 const MACRO: usize = 4;
 
@@ -45,6 +51,8 @@ pub struct Grid {
     macro_full: Vec<bool>,
     macro_resolution: [usize; 3],
     item_count: usize,
+    /// The resolution was coarsened to keep within [`REFERENCES_PER_ITEM`].
+    capped: bool,
     owner: u64,
 }
 
@@ -72,6 +80,7 @@ impl Grid {
             macro_full: vec![true],
             macro_resolution: [1; 3],
             item_count: item_bounds.len(),
+            capped: false,
             owner: new_owner(),
         };
         if bounded.is_empty() {
@@ -91,23 +100,22 @@ impl Grid {
             let cells = (extent[a] * per_unit).round() as usize;
             grid.resolution[a] = cells.clamp(1, MAX_RESOLUTION);
         }
-        grid.cell_size = Vec3::new(
-            extent.x / grid.resolution[0] as f64,
-            extent.y / grid.resolution[1] as f64,
-            extent.z / grid.resolution[2] as f64,
-        );
-        let inverse = |size: f64| if size > 0.0 { 1.0 / size } else { 0.0 };
-        grid.inv_cell_size = Vec3::new(
-            inverse(grid.cell_size.x),
-            inverse(grid.cell_size.y),
-            inverse(grid.cell_size.z),
-        );
-        let cell_count = grid.resolution.iter().product::<usize>();
-        // Two passes: count each cell's items, then file them (compressed rows).
         // Items are filed by their boxes grown a little, so that rounding in the cell
         // arithmetic can never leave an item out of a cell the ray meets it in.
         let margin = longest * 1e-9;
         let filed = |i: u32| item_bounds[i as usize].expanded(margin);
+        let budget = REFERENCES_PER_ITEM * bounded.len() + SPARE_REFERENCES;
+        loop {
+            grid.set_cell_size(extent);
+            let references: usize = bounded.iter().map(|&i| grid.cells_met(&filed(i))).sum();
+            if references <= budget || grid.resolution == [1; 3] {
+                break;
+            }
+            grid.capped = true;
+            grid.resolution = grid.resolution.map(|r| r.div_ceil(2));
+        }
+        let cell_count = grid.resolution.iter().product::<usize>();
+        // Two passes: count each cell's items, then file them (compressed rows).
         // Asked of a cell grown as the item's box is, and by a little of its size more,
         // so that the finer test's own rounding never leaves an item out either.
         let pad = margin + 1e-6 * grid.cell_size.max_component();
@@ -171,6 +179,31 @@ impl Grid {
 
     pub fn memory_bytes(&self) -> usize {
         (self.starts.len() + self.items.len() + self.large.len()) * 4 + self.macro_full.len()
+    }
+
+    /// Whether the resolution had to be coarsened to bound the cells' references (items
+    /// that overlap many cells each): rays then test more items per cell.
+    pub fn capped(&self) -> bool {
+        self.capped
+    }
+
+    /// Cell sizes and their inverses for the current resolution over a region of `extent`.
+    fn set_cell_size(&mut self, extent: Vec3) {
+        let r = self.resolution.map(|r| r as f64);
+        self.cell_size = Vec3::new(extent.x / r[0], extent.y / r[1], extent.z / r[2]);
+        let inverse = |size: f64| if size > 0.0 { 1.0 / size } else { 0.0 };
+        self.inv_cell_size = Vec3::new(
+            inverse(self.cell_size.x),
+            inverse(self.cell_size.y),
+            inverse(self.cell_size.z),
+        );
+    }
+
+    /// How many cells the box `b` meets.
+    fn cells_met(&self, b: &Bounds3) -> usize {
+        (0..3)
+            .map(|a| self.cell_of(b.max[a], a) - self.cell_of(b.min[a], a) + 1)
+            .product()
     }
 
     /// The cell of a point along one axis, clamped to the grid.

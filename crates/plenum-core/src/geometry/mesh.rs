@@ -217,6 +217,11 @@ impl TriangleMesh {
         Ok(mesh)
     }
 
+    /// Whether its structure had to bound its cells' references (see `Accel::capped`).
+    pub fn accel_capped(&self) -> bool {
+        self.accel.capped()
+    }
+
     /// The mesh with its triangles in a `kind` structure instead.
     pub fn with_accel(&self, kind: AccelKind) -> TriangleMesh {
         self.rebuilt(kind, EMBED_LIMIT)
