@@ -131,7 +131,11 @@ pub fn cbox_reference(file: &str) -> Option<PathBuf> {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/data/references/cbox")
         .join(file);
-    p.exists().then_some(p)
+    if !p.exists() {
+        super::missing(&format!("../shared/data/references/cbox/{file}"));
+        return None;
+    }
+    Some(p)
 }
 
 pub fn read_exr(p: &Path) -> Vec<[f32; 3]> {
@@ -160,7 +164,6 @@ pub fn cbox_z_test_with(
     tweak: impl Fn(&mut RenderSettings),
 ) {
     let (Some(r), Some(v)) = (cbox_reference(reference), cbox_reference(variance)) else {
-        eprintln!("../shared/data/references/cbox is not here: the Cornell box z-test has nothing to compare with");
         return;
     };
     let (reference, ref_var) = (read_exr(&r), read_exr(&v));
