@@ -34,6 +34,15 @@ fn light_tracing_and_bdpt_converge_in_the_furnace() {
     }
 }
 
+/// The methods that converge to the physically based image.
+const PHYSICAL: [IntegratorKind; 5] = [
+    IntegratorKind::Path,
+    IntegratorKind::Light,
+    IntegratorKind::Bdpt,
+    IntegratorKind::Photon,
+    IntegratorKind::Sppm,
+];
+
 /// Every method counts bounces alike: in the furnaces cut at `max_depth` D, light that
 /// bounced at most D + 1 times from the emitter to the eye arrives, 1 − 0.5^(D+1) under the
 /// point lights and 1 − 0.5^(D+2) from the emitting sphere (its emission seen directly
@@ -53,13 +62,7 @@ fn every_method_cuts_paths_at_the_same_depth() {
                 true => 1.0 - 0.5f64.powi(depth as i32 + 1),
                 false => 1.0 - 0.5f64.powi(depth as i32 + 2),
             };
-            for kind in [
-                IntegratorKind::Path,
-                IntegratorKind::Light,
-                IntegratorKind::Bdpt,
-                IntegratorKind::Photon,
-                IntegratorKind::Sppm,
-            ] {
+            for kind in PHYSICAL {
                 let (spp, tolerance) = match kind {
                     IntegratorKind::Photon => (64, 0.02),
                     IntegratorKind::Light => (1024, 0.01),
@@ -97,13 +100,7 @@ fn every_method_converges_with_every_sampler() {
         SamplerKind::Cook16,
         SamplerKind::Sobol,
     ] {
-        for kind in [
-            IntegratorKind::Path,
-            IntegratorKind::Light,
-            IntegratorKind::Bdpt,
-            IntegratorKind::Photon,
-            IntegratorKind::Sppm,
-        ] {
+        for kind in PHYSICAL {
             let (spp, tolerance) = match kind {
                 IntegratorKind::Light => (1024, 0.01),
                 IntegratorKind::Photon => (256, 0.02),
