@@ -57,13 +57,13 @@ struct ConvertArgs {
 #[derive(Args, Clone, Default)]
 struct ViewArgs {
     /// Image width in pixels.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<u32>(1, MAX_SIDE))]
     width: Option<u32>,
     /// Image height in pixels.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<u32>(1, MAX_SIDE))]
     height: Option<u32>,
-    /// Samples per pixel.
-    #[arg(long)]
+    /// Samples per pixel (1 to 65536).
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<u32>(1, MAX_SPP as u64))]
     spp: Option<u32>,
     /// Where samples go in a pixel (and on the lens, in time, over lights and glossy lobes):
     /// grid (regular √N×√N), random (N uniform points), jittered (one point in each cell of a
@@ -71,77 +71,77 @@ struct ViewArgs {
     /// adaptive (Whitted's corner subdivision; with --noise-threshold, sampling until the
     /// error estimate is below it, between --min-spp and --spp).
     /// The scene file's choice, else grid.
-    #[arg(long)]
+    #[arg(long, value_parser = named::<SamplerArg>(|| SAMPLERS.to_vec()))]
     sampler: Option<SamplerArg>,
     /// Reconstruction filter: box, tent, gaussian, mitchell or lanczos (default: the scene
     /// file's choice, else box).
-    #[arg(long)]
+    #[arg(long, value_parser = named::<FilterKind>(|| FilterKind::ALL.map(FilterKind::name).to_vec()))]
     filter: Option<FilterKind>,
     /// Filter radius in pixels (default: 0.5 box, 1 tent, 1.5 gaussian, 2 mitchell, 3 lanczos).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     filter_radius: Option<f64>,
     /// Adaptive subdivision: split where corner luminances differ by more than this
     /// contrast, (max − min)/(max + min).
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, default_value_t = 0.05, allow_negative_numbers = true)]
     contrast: f64,
     /// Adaptive subdivision: the deepest level (1 to 4; 4 = 16×16 squares per pixel).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true, value_parser = whole::<u32>(1, MAX_SUBDIVISION as u64))]
     adaptive_depth: u32,
     /// Adaptive sampling by variance: stop a pixel when the standard error of its luminance
     /// is below this fraction of its mean (of 0.05 in dark pixels), or at --spp samples
     /// (default: 16 × --min-spp, or the file's spp if larger).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     noise_threshold: Option<f64>,
     /// Adaptive sampling by variance: samples per pixel before the first check, and per batch.
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 16, allow_negative_numbers = true, value_parser = whole::<u32>(2, MAX_SPP as u64))]
     min_spp: u32,
     /// Maximum number of reflection/refraction bounces after the camera ray (0: direct light
-    /// only).
-    #[arg(long)]
+    /// only; at most 100).
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<u32>(0, MAX_DEPTH as u64))]
     max_depth: Option<u32>,
     /// The rendering method, the lecture's ladder: local (the Phong model from every light,
     /// no shadows), appel (local plus shadow rays), whitted (recursive ray tracing), path (path
     /// tracing), light (light tracing), photon (photon mapping), sppm (stochastic progressive
     /// photon mapping) or bdpt (bidirectional path tracing). Default: the scene file's choice,
     /// else path for a scene of physically based materials only and whitted otherwise.
-    #[arg(long)]
+    #[arg(long, value_parser = named::<IntegratorArg>(|| IntegratorKind::ALL.map(IntegratorKind::name).to_vec()))]
     integrator: Option<IntegratorArg>,
     /// How light is represented: spectral (4 sampled wavelengths per camera sample; the
     /// default) or rgb (three channels, as RGB renderers work).
-    #[arg(long)]
+    #[arg(long, value_parser = named::<ColorArg>(|| vec!["spectral", "rgb"]))]
     color: Option<ColorArg>,
     /// Path tracing: Russian roulette from this many bounces on (default 5).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<u32>(0, u32::MAX as u64))]
     rr_depth: Option<u32>,
     /// Path tracing: how next-event estimation picks a light: power (in proportion to its
     /// power; the default) or uniform.
-    #[arg(long)]
+    #[arg(long, value_parser = named::<LightSamplerArg>(|| vec!["power", "uniform"]))]
     light_sampler: Option<LightSamplerArg>,
     /// Photon mapping: photon paths traced for the global map (default 200000).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<u64>(0, u64::MAX))]
     photons: Option<u64>,
     /// Photon mapping: photon paths traced for the caustic map (default 200000; 0: none).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<u64>(0, u64::MAX))]
     caustic_photons: Option<u64>,
     /// Photon mapping: photons per density estimate, k (default 64).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<u32>(0, u32::MAX as u64))]
     photon_nearest: Option<u32>,
     /// Photon mapping: the largest gather radius; SPPM: the initial radius, in scene units
     /// (default 0: automatic).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     photon_radius: Option<f64>,
     /// Photon mapping: final-gather rays per camera sample (default 1).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<u32>(0, u32::MAX as u64))]
     gather_rays: Option<u32>,
     /// SPPM: photon paths per iteration (default 0: the image's pixel count); the
     /// iterations are --spp.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<u64>(0, u64::MAX))]
     sppm_photons: Option<u64>,
     /// SPPM: the fraction α of new photons kept as a pixel's radius shrinks (default 2/3).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     sppm_alpha: Option<f64>,
-    /// Random seed.
-    #[arg(long, default_value_t = 0)]
+    /// Random seed (0 to 2^64 − 1).
+    #[arg(long, default_value_t = 0, allow_negative_numbers = true, value_parser = whole::<u64>(0, u64::MAX))]
     seed: u64,
     /// The SPD test procedure: one ray through each pixel corner ((W+1)×(H+1) rays), each
     /// pixel the mean of its four corners; an NFF view angle then spans the corner rays.
@@ -160,13 +160,13 @@ struct RenderArgs {
     view: ViewArgs,
     /// Worker threads (default, or 0: all cores; at most 1024). The image does not depend
     /// on it.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = whole::<usize>(0, MAX_THREADS as u64))]
     threads: Option<usize>,
     /// Exposure in stops, for PNG output (−64 to 64).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     exposure: Option<f64>,
     /// Acceleration structure: bvh (default), grid, octree or none (brute force).
-    #[arg(long, default_value = "bvh")]
+    #[arg(long, default_value = "bvh", value_parser = named::<AccelKind>(|| AccelKind::ALL.map(AccelKind::name).to_vec()))]
     accel: AccelKind,
     /// No progress bar and no summary.
     #[arg(short, long)]
@@ -182,10 +182,12 @@ struct RenderArgs {
 struct TracePixelArgs {
     /// Scene file (.toml); `-` for the built-in scene.
     scene: PathBuf,
-    /// Pixel column, from the left.
-    x: u32,
-    /// Pixel row, from the top.
-    y: u32,
+    /// Pixel column, from the left (0 to width − 1).
+    #[arg(allow_negative_numbers = true)]
+    x: i64,
+    /// Pixel row, from the top (0 to height − 1).
+    #[arg(allow_negative_numbers = true)]
+    y: i64,
     /// Print JSON instead of an indented tree.
     #[arg(long)]
     json: bool,
@@ -277,6 +279,49 @@ impl std::fmt::Display for SamplerArg {
         }
     }
 }
+
+/// `--sampler`'s names.
+const SAMPLERS: [&str; 6] = ["grid", "random", "jittered", "cook16", "sobol", "adaptive"];
+
+/// A value parser for a name among `names()`: `T`'s own parse, and where it fails, the name
+/// that was probably meant, as scene files get.
+fn named<T: std::str::FromStr<Err = String>>(
+    names: fn() -> Vec<&'static str>,
+) -> impl Fn(&str) -> Result<T, String> + Clone + Send + Sync + 'static {
+    move |s| {
+        s.parse::<T>().map_err(
+            |e| match plenum_scene::diagnostics::did_you_mean(s, names()) {
+                Some(m) => format!("{e}; did you mean `{m}`?"),
+                None => e,
+            },
+        )
+    }
+}
+
+/// A value parser for a whole number from `lo` to `hi`, which says so when given anything
+/// else (a negative number included).
+fn whole<T: TryFrom<u64>>(
+    lo: u64,
+    hi: u64,
+) -> impl Fn(&str) -> Result<T, String> + Clone + Send + Sync + 'static {
+    move |s| {
+        let range = if hi == u64::MAX {
+            format!("a whole number ≥ {lo}")
+        } else {
+            format!("a whole number from {lo} to {hi}")
+        };
+        s.trim()
+            .parse::<u64>()
+            .ok()
+            .filter(|n| (lo..=hi).contains(n))
+            .and_then(|n| T::try_from(n).ok())
+            .ok_or_else(|| format!("expected {range}, not `{s}`"))
+    }
+}
+
+/// The longest image side `--width` and `--height` take (the image is also held to 2^28
+/// pixels).
+const MAX_SIDE: u64 = 1 << 20;
 
 static CANCEL: AtomicBool = AtomicBool::new(false);
 
@@ -460,8 +505,8 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
     photon.gather_rays = view.gather_rays.unwrap_or(photon.gather_rays);
     photon.sppm_photons = view.sppm_photons.unwrap_or(photon.sppm_photons);
     photon.alpha = view.sppm_alpha.unwrap_or(photon.alpha);
-    if let Err(e) = photon.check() {
-        eprintln!("error: {e} (--photons, --caustic-photons, --photon-nearest, --photon-radius, --gather-rays, --sppm-photons, --sppm-alpha)");
+    if let Err((key, e)) = photon.check_field() {
+        eprintln!("error: --{}: {e}", key.replace('_', "-"));
         return Err(ExitCode::from(2));
     }
     let settings = RenderSettings {
@@ -511,6 +556,14 @@ fn ray_summary(c: &plenum_core::integrator::RayCounts) -> String {
 }
 
 fn convert(args: ConvertArgs) -> ExitCode {
+    let extension = args.output.extension().and_then(|e| e.to_str());
+    if !extension.is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
+        eprintln!(
+            "error: convert writes the native scene format, TOML: name the output .toml, not {}",
+            args.output.display()
+        );
+        return ExitCode::from(2);
+    }
     let loaded = match load(Some(&args.input)) {
         Ok(l) => l,
         Err(code) => return code,

@@ -18,31 +18,30 @@ pub fn run(args: TracePixelArgs) -> ExitCode {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if args.x >= settings.width || args.y >= settings.height {
+    let (w, h) = (settings.width, settings.height);
+    if !(0..w as i64).contains(&args.x) || !(0..h as i64).contains(&args.y) {
         eprintln!(
-            "error: pixel ({}, {}) is outside the {}×{} image",
-            args.x, args.y, settings.width, settings.height
+            "error: pixel ({}, {}) is outside the {w}×{h} image: X must be from 0 to {}, Y from 0 to {}",
+            args.x,
+            args.y,
+            w - 1,
+            h - 1
         );
         return ExitCode::from(2);
     }
-    let (tree, color) = trace_pixel(&loaded.scene, &settings, args.x, args.y);
+    let (x, y) = (args.x as u32, args.y as u32);
+    let (tree, color) = trace_pixel(&loaded.scene, &settings, x, y);
     let mut out = String::new();
     if args.json {
         let doc = json!({
-            "pixel": [args.x, args.y],
+            "pixel": [x, y],
             "color": rgb(color),
             "rays": tree.nodes.iter().enumerate().map(|(i, n)| node_json(i, n)).collect::<Vec<_>>(),
         });
         out = serde_json::to_string_pretty(&doc).unwrap_or_default();
         out.push('\n');
     } else {
-        let _ = writeln!(
-            out,
-            "pixel ({}, {}): colour {}",
-            args.x,
-            args.y,
-            fmt_color(color)
-        );
+        let _ = writeln!(out, "pixel ({x}, {y}): colour {}", fmt_color(color));
         for root in (0..tree.nodes.len()).filter(|&i| tree.nodes[i].parent.is_none()) {
             print_node(&mut out, &tree, root, 0);
         }

@@ -639,3 +639,146 @@ fn an_image_larger_than_memory_is_refused_before_rendering() {
     assert!(stderr(&o).contains("needs about"), "{}", stderr(&o));
     assert!(stderr(&o).contains("ulimit -v"), "{}", stderr(&o));
 }
+
+/// What a newcomer tries in the first hour: negative numbers where an option takes them, a
+/// range where it does not, a name mistyped, a file that is not a scene, a scene with no
+/// light, a coefficient above 1.
+#[test]
+fn a_newcomers_mistakes_get_clear_answers() {
+    let tmp = temp_dir("newcomer");
+    let dir = tmp.path();
+    let out = dir.join("out.png");
+    let o_path = out.to_str().unwrap();
+    let small = ["--width", "8", "--height", "6", "--quiet", "-o", o_path];
+    let run = |args: &[&str]| plenum().args(args).output().unwrap();
+    let refused = |args: &[&str], says: &[&str]| {
+        let o = run(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        for s in says {
+            assert!(stderr(&o).contains(s), "{args:?}: {}", stderr(&o));
+        }
+        stderr(&o)
+    };
+
+    // A negative exposure is a value, not an unknown argument.
+    let o = run(&[&["render", "--exposure", "-6"][..], &small].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&[&["render", "--exposure", "-6.5", "--seed", "3"][..], &small].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    // Where an option takes no negative value, its range is the answer.
+    refused(
+        &[&["render", "--spp", "-4"][..], &small].concat(),
+        &["--spp", "from 1 to 65536", "`-4`"],
+    );
+    refused(
+        &[&["render", "--max-depth", "-1"][..], &small].concat(),
+        &["--max-depth", "from 0 to 100"],
+    );
+    refused(
+        &[&["render", "--seed", "-1"][..], &small].concat(),
+        &["--seed", "≥ 0"],
+    );
+    refused(
+        &[
+            "trace-pixel",
+            "-",
+            "-1",
+            "5",
+            "--width",
+            "8",
+            "--height",
+            "6",
+        ],
+        &["(-1, 5)", "X must be from 0 to 7"],
+    );
+    refused(
+        &[
+            "trace-pixel",
+            "-",
+            "3",
+            "6",
+            "--width",
+            "8",
+            "--height",
+            "6",
+        ],
+        &["Y from 0 to 5"],
+    );
+    // A mistyped name is answered with the likely one.
+    refused(
+        &[&["render", "--integrator", "bpdt"][..], &small].concat(),
+        &["unknown integrator `bpdt`", "did you mean `bdpt`?"],
+    );
+    refused(
+        &[&["render", "--sampler", "jitered"][..], &small].concat(),
+        &["did you mean `jittered`?"],
+    );
+    refused(
+        &[&["render", "--accel", "octtree"][..], &small].concat(),
+        &["did you mean `octree`?"],
+    );
+    // A bad photon setting names itself alone.
+    let e = refused(
+        &[
+            &["render", "--integrator", "sppm", "--sppm-alpha", "2"][..],
+            &small,
+        ]
+        .concat(),
+        &["--sppm-alpha", "between 0 and 1"],
+    );
+    assert!(
+        !e.contains("--photons") && !e.contains("--gather-rays"),
+        "{e}"
+    );
+    let e = refused(
+        &[
+            &["render", "--integrator", "photon", "--gather-rays", "0"][..],
+            &small,
+        ]
+        .concat(),
+        &["--gather-rays"],
+    );
+    assert!(!e.contains("--sppm-alpha"), "{e}");
+
+    // A file that is not a scene, and a converted scene named as an image.
+    let readme = write(dir, "README.md", "# Not a scene\n\nSome text.\n");
+    refused(
+        &[&["render", readme.to_str().unwrap()][..], &small].concat(),
+        &[
+            "README.md",
+            "not a scene file",
+            ".toml",
+            ".nff",
+            ".ray",
+            ".obj",
+            ".ply",
+        ],
+    );
+    let scene = write(
+        dir,
+        "dark.toml",
+        "[camera]\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\n\n[materials.glass]\ndiffuse = 0.2\ntransmissive = 1.5\n\n[[objects]]\ntype = \"sphere\"\nmaterial = \"glass\"\ncenter = [0, 0, 0]\nradius = 1\n",
+    );
+    let png = dir.join("dark.png");
+    refused(
+        &["convert", scene.to_str().unwrap(), png.to_str().unwrap()],
+        &["name the output .toml"],
+    );
+    assert!(!png.exists(), "nothing is written under a wrong name");
+    let toml = dir.join("dark-copy.toml");
+    let o = run(&["convert", scene.to_str().unwrap(), toml.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+
+    // No light at all, and k_t above 1: rendered, with located warnings.
+    let o = run(&[&["render", scene.to_str().unwrap()][..], &small].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("warning:") && e.contains("no light"), "{e}");
+    assert!(
+        e.contains("transmissive 1.5 exceeds 1") && e.contains("dark.toml:7:"),
+        "{e}"
+    );
+    // A lit scene gets neither warning.
+    let o = run(&[&["render"][..], &small].concat());
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
+}

@@ -86,9 +86,14 @@ impl Film {
 
     /// Adds the splats summed in `buffer`.
     pub fn add_splats(&mut self, buffer: &SplatBuffer) {
-        for (s, b) in self.splats.iter_mut().zip(&buffer.sums) {
+        self.add_splat_sums(&buffer.sums());
+    }
+
+    /// Adds splat sums in [`SplatBuffer`]'s fixed point, one per pixel.
+    pub fn add_splat_sums(&mut self, sums: &[[i64; 3]]) {
+        for (s, b) in self.splats.iter_mut().zip(sums) {
             for c in 0..3 {
-                s[c] += b[c].load(Ordering::Relaxed) as f64 * SplatBuffer::UNIT;
+                s[c] += b[c] as f64 * SplatBuffer::UNIT;
             }
         }
     }
@@ -199,6 +204,23 @@ impl SplatBuffer {
                 self.clamped.fetch_add(1, Ordering::Relaxed);
             }
             sum.fetch_add(units.clamp(-Self::MAX, Self::MAX) as i64, Ordering::Relaxed);
+        }
+    }
+
+    /// The sums so far, per pixel, in fixed point.
+    pub fn sums(&self) -> Vec<[i64; 3]> {
+        self.sums
+            .iter()
+            .map(|s| s.each_ref().map(|v| v.load(Ordering::Relaxed)))
+            .collect()
+    }
+
+    /// Starts from `sums` (a render being continued), one per pixel.
+    pub fn preload(&self, sums: &[[i64; 3]]) {
+        for (s, v) in self.sums.iter().zip(sums) {
+            for c in 0..3 {
+                s[c].store(v[c], Ordering::Relaxed);
+            }
         }
     }
 

@@ -16,6 +16,7 @@ pub mod light_sampler;
 pub mod material;
 pub mod math;
 pub mod optics;
+pub mod raw_film;
 pub mod render;
 pub mod sampling;
 pub mod scene;

@@ -448,6 +448,18 @@ impl Scene {
         Some(self.rgb_radiance(m.emissive.evaluate(&it.texture), wl))
     }
 
+    /// Whether nothing in the scene gives light (no light source or emitting surface, no
+    /// Phong k_e, a black background, no ambient light): its image is black by any method.
+    pub fn emits_nothing(&self) -> bool {
+        self.lights.is_empty()
+            && self.ambient.is_black()
+            && self.background.is_black()
+            && self
+                .materials
+                .iter()
+                .all(|m| m.phong().is_none_or(|p| p.emissive.is_black()))
+    }
+
     /// The background's radiance at the sample's wavelengths.
     #[inline]
     pub fn background_spectrum(&self, wl: &SampledWavelengths) -> SampledSpectrum {

@@ -57,6 +57,19 @@ impl Texture {
         }
     }
 
+    /// The largest channel value the texture takes anywhere (an image's: at most 1 after
+    /// decoding, so 1 is an upper bound).
+    pub fn max_component(&self) -> f64 {
+        let max = |c: &Color| c.r.max(c.g).max(c.b);
+        match self {
+            Texture::Constant(c) => max(c),
+            Texture::Checker2d { even, odd, .. } | Texture::Checker3d { even, odd, .. } => {
+                max(even).max(max(odd))
+            }
+            Texture::Image(_) => 1.0,
+        }
+    }
+
     /// True when the texture is black everywhere: lets the integrator skip work.
     pub fn is_black(&self) -> bool {
         match self {

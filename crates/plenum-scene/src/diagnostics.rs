@@ -58,6 +58,11 @@ impl SceneError {
         }
     }
 
+    /// The message shown as a warning: something read past, not a reason to stop.
+    pub fn as_warning(&self) -> String {
+        self.to_string().replacen("error:", "warning:", 1)
+    }
+
     pub fn with_help(mut self, help: impl Into<String>) -> Self {
         self.help = Some(help.into());
         self

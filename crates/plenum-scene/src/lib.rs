@@ -105,16 +105,30 @@ pub fn load_mesh(path: &Path) -> Result<plenum_core::geometry::TriangleMesh, Sce
     }
 }
 
-/// Reads a scene file, choosing the format by extension: `.nff` (Haines' Neutral File
-/// Format), `.ray` (the course ray tracer's format), `.obj` and `.ply` (a mesh, framed by a
-/// default camera and lights), anything else the native TOML. Relative paths inside are resolved against the
-/// file's folder.
+/// The extensions of the scene files Plenum reads, by reader.
+pub const SCENE_EXTENSIONS: [&str; 5] = ["toml", "nff", "ray", "obj", "ply"];
+
+/// Reads a scene file, choosing the format by extension: `.toml` (the native format), `.nff`
+/// (Haines' Neutral File Format), `.ray` (the course ray tracer's format), `.obj` and `.ply`
+/// (a mesh, framed by a default camera and lights); any other is refused. Relative paths
+/// inside are resolved against the file's folder.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
+    if !SCENE_EXTENSIONS.contains(&extension.as_str()) {
+        let found = if extension.is_empty() {
+            "it has no extension".to_string()
+        } else {
+            format!("`.{extension}` is not one")
+        };
+        return Err(SceneError::file(
+            path,
+            format!("not a scene file Plenum reads: {found}; the formats are .toml (native), .nff, .ray, .obj and .ply"),
+        ));
+    }
     let bytes = std::fs::read(path)
         .map_err(|e| SceneError::file(path, format!("cannot read the scene file: {e}")))?;
     read_scene(path, &extension, bytes)
@@ -150,6 +164,11 @@ pub fn read_scene(path: &Path, extension: &str, bytes: Vec<u8>) -> Result<Loaded
         _ => parse_scene(path, &text, base)?,
     };
     loaded.warnings.splice(0..0, not_utf8);
+    if loaded.scene.emits_nothing() {
+        loaded.warnings.push(
+            SceneError::file(path, "the scene has no light: no light source, no emitting surface, a black background and no ambient light, so the image will be black").as_warning(),
+        );
+    }
     Ok(loaded)
 }
 

@@ -561,6 +561,21 @@ impl<'s> Reader<'s> {
                 Some(_) => Some(f.positive("gloss", None)?),
             },
         };
+        // Whitted's coefficients are fractions of the light arriving: above 1 a surface
+        // returns more than it receives, and recursion multiplies the excess.
+        for (key, t) in [
+            ("diffuse", &m.diffuse),
+            ("reflective", &m.reflective),
+            ("transmissive", &m.transmissive),
+        ] {
+            if let Some(v) = f.get(key).filter(|_| t.max_component() > 1.0) {
+                let e = self.src.error(
+                    v.span(),
+                    format!("{key} {} exceeds 1: the surface gives out more light than reaches it (energy is not conserved)", t.max_component()),
+                );
+                self.warnings.push(e.as_warning());
+            }
+        }
         let id = self.builder.add_material(name, m);
         self.materials.insert(name.to_string(), id);
         Ok(())

@@ -25,8 +25,7 @@ pub fn lenient(path: &Path, bytes: Vec<u8>) -> (String, Option<String>) {
                 at..at + '\u{FFFD}'.len_utf8(),
                 "this byte is not UTF-8; it and any others like it are read as U+FFFD (�)",
             );
-            let warning = warning.to_string().replacen("error:", "warning:", 1);
-            (text, Some(warning))
+            (text, Some(warning.as_warning()))
         }
     }
 }

@@ -167,31 +167,54 @@ impl PhotonConfig {
 
     /// Whether the settings make sense; what is wrong where they do not.
     pub fn check(&self) -> Result<(), String> {
-        if self.photons == 0 || self.photons > Self::MAX_PHOTONS {
-            return Err(format!(
-                "photons must be between 1 and {} photon paths",
-                Self::MAX_PHOTONS
+        self.check_field().map_err(|(_, e)| e)
+    }
+
+    /// [`check`](Self::check), with the setting at fault: its key in a scene file's
+    /// `[render]` table (`sppm_alpha`), which the command line spells `--sppm-alpha`.
+    pub fn check_field(&self) -> Result<(), (&'static str, String)> {
+        let max = Self::MAX_PHOTONS;
+        if self.photons == 0 || self.photons > max {
+            return Err((
+                "photons",
+                format!("photons must be between 1 and {max} photon paths"),
             ));
         }
-        if self.caustic_photons > Self::MAX_PHOTONS || self.sppm_photons > Self::MAX_PHOTONS {
-            return Err(format!(
-                "caustic and SPPM photon counts must be at most {} photon paths",
-                Self::MAX_PHOTONS
+        if self.caustic_photons > max {
+            return Err((
+                "caustic_photons",
+                format!("caustic photons must be at most {max} photon paths (0: no caustic map)"),
+            ));
+        }
+        if self.sppm_photons > max {
+            return Err((
+                "sppm_photons",
+                format!("SPPM photons must be at most {max} photon paths per iteration (0: the pixel count)"),
             ));
         }
         if self.nearest == 0 || self.nearest > MAX_NEAREST {
-            return Err(format!(
-                "the photons per density estimate must be between 1 and {MAX_NEAREST}"
+            return Err((
+                "photon_nearest",
+                format!("the photons per density estimate must be between 1 and {MAX_NEAREST}"),
             ));
         }
         if !(self.radius >= 0.0 && self.radius.is_finite()) {
-            return Err("the photon radius must be a number ≥ 0 (0: automatic)".to_string());
+            return Err((
+                "photon_radius",
+                "the photon radius must be a number ≥ 0 (0: automatic)".to_string(),
+            ));
         }
         if self.gather_rays == 0 || self.gather_rays > 1024 {
-            return Err("the final-gather rays must be between 1 and 1024".to_string());
+            return Err((
+                "gather_rays",
+                "the final-gather rays must be between 1 and 1024".to_string(),
+            ));
         }
         if !(self.alpha > 0.0 && self.alpha < 1.0) {
-            return Err("the SPPM alpha must lie strictly between 0 and 1".to_string());
+            return Err((
+                "sppm_alpha",
+                "the SPPM alpha must lie strictly between 0 and 1".to_string(),
+            ));
         }
         Ok(())
     }

@@ -1,0 +1,286 @@
+//! The raw film: what a render has summed so far, exactly, so that it can be saved,
+//! continued and added to other renders' sums.
+//!
+//! Each pixel keeps Σ w·L, Σ w and Σ L of its samples in fixed point: every sample is
+//! rounded to a multiple of 2⁻³² first and the sums are integers, so they do not depend on
+//! the order the samples were added in. A render stopped and continued, or split into sample
+//! ranges on several machines and merged, therefore sums to the same integers as one
+//! uninterrupted render and resolves to the same bytes. (Splats are summed the same way, in
+//! [`SplatBuffer`](crate::film::SplatBuffer).)
+
+use crate::color::Color;
+use crate::film::Film;
+use std::ops::Range;
+
+/// Fixed-point units per unit of radiance (or filter weight): 2³².
+const SCALE: f64 = 4_294_967_296.0;
+/// The largest sample, in units (2⁶⁸ in value): 2¹⁶ of them still fit an `i128`.
+const MAX_UNITS: i128 = 1 << 100;
+
+fn units(v: f64) -> i128 {
+    // `as` saturates (and maps NaN to 0); the integrators have already left out samples
+    // that are not finite.
+    ((v * SCALE).round() as i128).clamp(-MAX_UNITS, MAX_UNITS)
+}
+
+fn value(units: i128) -> f64 {
+    units as f64 / SCALE
+}
+
+/// One pixel's samples so far.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelSums {
+    /// Σ w·L per channel, in units of 2⁻³².
+    pub weighted: [i128; 3],
+    /// Σ w, in units of 2⁻³².
+    pub weight: i128,
+    /// Σ L per channel, in units of 2⁻³².
+    pub plain: [i128; 3],
+    pub count: u32,
+    /// Σ Y and Σ Y² of the samples' luminance, for adaptive sampling, in the order the
+    /// samples were taken (adaptive renders are continued, never split).
+    pub luminance: f64,
+    pub luminance_squared: f64,
+}
+
+impl PixelSums {
+    /// A pixel computed whole (adaptive subdivision, a corner ray): one sample of `c`.
+    pub fn single(c: Color) -> PixelSums {
+        let mut s = PixelSums::default();
+        s.add(c, 1.0);
+        s
+    }
+
+    pub fn add(&mut self, c: Color, weight: f64) {
+        for (i, v) in [c.r, c.g, c.b].into_iter().enumerate() {
+            self.weighted[i] += units(v * weight);
+            self.plain[i] += units(v);
+        }
+        self.weight += units(weight);
+        self.count += 1;
+        let y = c.luminance();
+        self.luminance += y;
+        self.luminance_squared += y * y;
+    }
+
+    /// Σ w·L / Σ w; should the weights of a filter with negative lobes cancel out (a few
+    /// samples, all unlucky), the plain mean instead of a division by nearly zero.
+    pub fn value(&self) -> Color {
+        let w = self.weight as f64;
+        if value(self.weight) > 0.25 * self.count as f64 {
+            let [r, g, b] = self.weighted.map(|s| s as f64 / w);
+            Color::new(r, g, b)
+        } else {
+            let n = self.count.max(1) as f64;
+            let [r, g, b] = self.plain.map(|s| value(s) / n);
+            Color::new(r, g, b)
+        }
+    }
+
+    /// Whether the standard error of the luminance is at most `threshold` × max(mean, 0.05).
+    pub fn converged(&self, threshold: f64) -> bool {
+        let n = self.count as f64;
+        if self.count < 2 {
+            return false;
+        }
+        let mean = self.luminance / n;
+        let variance = ((self.luminance_squared - n * mean * mean) / (n - 1.0)).max(0.0);
+        (variance / n).sqrt() <= threshold * mean.max(0.05)
+    }
+
+    fn merge(&mut self, o: &PixelSums) {
+        for i in 0..3 {
+            self.weighted[i] += o.weighted[i];
+            self.plain[i] += o.plain[i];
+        }
+        self.weight += o.weight;
+        self.count += o.count;
+        self.luminance += o.luminance;
+        self.luminance_squared += o.luminance_squared;
+    }
+}
+
+/// A render's state: every pixel's sums, how far each pixel has got, and the splats.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RawFilm {
+    /// Of the grid sampled: the image, or its corner lattice (one more each way).
+    pub width: u32,
+    pub height: u32,
+    /// The SPD corner grid: each pixel of the image is the mean of four of these.
+    pub corners: bool,
+    /// The sample indices this film is to hold of every pixel (a fixed-count render);
+    /// pixel p holds `samples.start .. samples.start + count`.
+    pub samples: Range<u32>,
+    pub pixels: Vec<PixelSums>,
+    /// Per pixel, the passes finished: a fixed-count render does not use them (its counts
+    /// tell); adaptive subdivision and corners finish in 1, sampling by variance in 2.
+    pub stages: Vec<u8>,
+    /// Sampling by variance, once its first pass is done: the pixels not converged after it.
+    pub open: Vec<bool>,
+    /// Splat sums per pixel, in [`SplatBuffer`](crate::film::SplatBuffer)'s fixed point;
+    /// empty for integrators that do not splat.
+    pub splats: Vec<[i64; 3]>,
+}
+
+impl RawFilm {
+    pub fn new(width: u32, height: u32, corners: bool, samples: Range<u32>) -> RawFilm {
+        let n = width as usize * height as usize;
+        RawFilm {
+            width,
+            height,
+            corners,
+            samples,
+            pixels: vec![PixelSums::default(); n],
+            stages: vec![0; n],
+            open: Vec::new(),
+            splats: Vec::new(),
+        }
+    }
+
+    /// Whether every pixel holds all the samples of its range (a fixed-count render).
+    pub fn has_all_samples(&self) -> bool {
+        let n = self.samples.len() as u32;
+        self.pixels.iter().all(|p| p.count == n)
+    }
+
+    /// The image: each pixel's weighted mean plus its splats; for a corner grid, each pixel
+    /// the mean of its four corners.
+    pub fn image(&self) -> Film {
+        let mut film = Film::new(self.width, self.height);
+        for y in 0..self.height {
+            for x in 0..self.width {
+                let i = y as usize * self.width as usize + x as usize;
+                film.set(x, y, self.pixels[i].value());
+            }
+        }
+        if !self.splats.is_empty() {
+            film.add_splat_sums(&self.splats);
+        }
+        film.resolve(1.0);
+        if !self.corners {
+            return film;
+        }
+        let (w, h) = (self.width - 1, self.height - 1);
+        let mut image = Film::new(w, h);
+        for y in 0..h {
+            for x in 0..w {
+                let sum = film.get(x, y)
+                    + film.get(x + 1, y)
+                    + film.get(x, y + 1)
+                    + film.get(x + 1, y + 1);
+                image.set(x, y, sum * 0.25);
+            }
+        }
+        image
+    }
+
+    /// The sum of renders of consecutive sample ranges of one image, each complete: the
+    /// film of their whole range. Parts are added in the order of their ranges.
+    pub fn merge(mut parts: Vec<RawFilm>) -> Result<RawFilm, String> {
+        parts.sort_by_key(|p| (p.samples.start, p.samples.end));
+        let mut parts = parts.into_iter();
+        let Some(mut sum) = parts.next() else {
+            return Err("nothing to merge".to_string());
+        };
+        if sum.corners || !sum.open.is_empty() || sum.stages.iter().any(|&s| s != 0) {
+            return Err("only renders with a fixed number of samples per pixel can be merged (not adaptive sampling or the SPD corners)".to_string());
+        }
+        for part in parts {
+            let (a, b) = (&sum.samples, &part.samples);
+            if (part.width, part.height) != (sum.width, sum.height) {
+                return Err(format!(
+                    "the parts differ in size: {}×{} and {}×{}",
+                    sum.width, sum.height, part.width, part.height
+                ));
+            }
+            if b.start < a.end {
+                return Err(format!(
+                    "sample ranges {}..{} and {}..{} overlap: their samples would count twice",
+                    a.start, a.end, b.start, b.end
+                ));
+            }
+            if b.start > a.end {
+                return Err(format!(
+                    "samples {}..{} are missing between the parts",
+                    a.end, b.start
+                ));
+            }
+            if part.splats.len() != sum.splats.len()
+                || part.corners
+                || part.stages.iter().any(|&s| s != 0)
+            {
+                return Err("the parts were rendered differently".to_string());
+            }
+            for (s, p) in sum.pixels.iter_mut().zip(&part.pixels) {
+                s.merge(p);
+            }
+            for (s, p) in sum.splats.iter_mut().zip(&part.splats) {
+                for c in 0..3 {
+                    s[c] = s[c].wrapping_add(p[c]);
+                }
+            }
+            sum.samples = sum.samples.start..part.samples.end;
+        }
+        Ok(sum)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Sums do not depend on the order samples arrive in, nor on how they are split up.
+    #[test]
+    fn sums_are_exact_in_any_order() {
+        let samples: Vec<(Color, f64)> = (0..200)
+            .map(|i| {
+                let t = i as f64;
+                (
+                    Color::new((t * 0.37).sin().abs() * 1e3, 1.0 / (t + 1.0), t.sqrt()),
+                    0.1 + (t * 0.11).cos().abs(),
+                )
+            })
+            .collect();
+        let mut forward = PixelSums::default();
+        samples.iter().for_each(|&(c, w)| forward.add(c, w));
+        let mut backward = PixelSums::default();
+        samples.iter().rev().for_each(|&(c, w)| backward.add(c, w));
+        assert_eq!(forward.weighted, backward.weighted);
+        assert_eq!(forward.weight, backward.weight);
+        assert_eq!(forward.plain, backward.plain);
+        let mut parts = Vec::new();
+        for range in [0..70, 70..71, 71..200] {
+            let mut film = RawFilm::new(1, 1, false, range.start as u32..range.end as u32);
+            samples[range]
+                .iter()
+                .for_each(|&(c, w)| film.pixels[0].add(c, w));
+            parts.push(film);
+        }
+        parts.swap(0, 2);
+        let merged = RawFilm::merge(parts).unwrap();
+        assert_eq!(merged.samples, 0..200);
+        assert_eq!(merged.pixels[0].weighted, forward.weighted);
+        assert_eq!(merged.pixels[0].count, 200);
+        assert_eq!(merged.image().get(0, 0), {
+            let mut f = RawFilm::new(1, 1, false, 0..200);
+            f.pixels[0] = forward;
+            f.image().get(0, 0)
+        });
+        // Within the rounding of 2⁻³² per sample of the floating-point weighted mean.
+        let (sw, swl) = samples
+            .iter()
+            .fold((0.0, 0.0), |(sw, swl), &(c, w)| (sw + w, swl + w * c.g));
+        assert!((forward.value().g - swl / sw).abs() < 1e-9);
+    }
+
+    #[test]
+    fn merge_refuses_overlaps_and_gaps() {
+        let part = |r: Range<u32>| RawFilm::new(2, 2, false, r);
+        let e = RawFilm::merge(vec![part(0..4), part(3..8)]).unwrap_err();
+        assert!(e.contains("overlap"), "{e}");
+        let e = RawFilm::merge(vec![part(0..4), part(5..8)]).unwrap_err();
+        assert!(e.contains("4..5 are missing"), "{e}");
+        let e = RawFilm::merge(vec![part(0..4), RawFilm::new(2, 3, false, 4..8)]).unwrap_err();
+        assert!(e.contains("size"), "{e}");
+    }
+}
