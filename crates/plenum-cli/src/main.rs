@@ -6,6 +6,7 @@
 mod bench;
 #[cfg(feature = "embree")]
 mod embree;
+mod film_file;
 mod memory;
 mod trace;
 
@@ -13,14 +14,17 @@ use clap::{Args, Parser, Subcommand};
 use plenum_core::accel::AccelKind;
 use plenum_core::integrator::{ColorMode, IntegratorConfig, IntegratorKind, MAX_DEPTH};
 use plenum_core::light_sampler::LightSamplerKind;
-use plenum_core::render::{render, Adaptive, RenderSettings, MAX_SUBDIVISION};
+use plenum_core::raw_film::RawFilm;
+use plenum_core::render::{
+    new_film, render, render_film, Adaptive, RenderControl, RenderSettings, MAX_SUBDIVISION,
+};
 use plenum_core::sampling::{Filter, FilterKind, PixelSampler, SamplerKind, MAX_SPP};
 use plenum_scene::{builtin_scene, load_scene, LoadedScene};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 #[derive(Parser)]
 #[command(
@@ -36,6 +40,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene to an image (with no scene: Whitted's 1980 picture).
+    #[command(args_override_self = true)]
     Render(RenderArgs),
     /// Print the ray tree of one pixel: every ray traced for it and why each branch ended.
     TracePixel(TracePixelArgs),
@@ -43,6 +48,22 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Write any scene Plenum reads (.toml, .nff, .ray, .obj, .ply) in the native format.
     Convert(ConvertArgs),
+    /// Sum film files (.plf) of one render's sample ranges (`render --samples A..B`) into
+    /// its image.
+    Merge(MergeArgs),
+}
+
+#[derive(Args)]
+struct MergeArgs {
+    /// The parts: film files of consecutive sample ranges of one scene and settings.
+    #[arg(required = true)]
+    parts: Vec<PathBuf>,
+    /// The image to write (.png, .exr, .pfm, .hdr), or a film file (.plf) to merge further.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Exposure in stops, for PNG output (−64 to 64).
+    #[arg(long, allow_negative_numbers = true)]
+    exposure: Option<f64>,
 }
 
 #[derive(Args)]
@@ -153,9 +174,31 @@ struct ViewArgs {
 struct RenderArgs {
     /// Scene file (.toml). Without one, the built-in scene.
     scene: Option<PathBuf>,
-    /// Output image; the extension picks the format: .png, .exr, .pfm, .hdr.
+    /// Output image; the extension picks the format: .png, .exr, .pfm, .hdr; or .plf, the
+    /// raw film (for `plenum merge`).
     #[arg(short, long, default_value = "plenum.png")]
     output: PathBuf,
+    /// Save the render's state to this film file (.plf) every --checkpoint-every seconds
+    /// and when it is stopped (Ctrl-C, --time-limit); `--resume FILE` continues it. Removed
+    /// once the image is written.
+    #[arg(long)]
+    checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints.
+    #[arg(long, default_value_t = 60.0)]
+    checkpoint_every: f64,
+    /// Continue the render saved in this checkpoint, with its scene and settings (only
+    /// --threads, --quiet, --time-limit and --checkpoint-every may be given with it); the
+    /// image is the same, to the byte, as that of a render never stopped.
+    #[arg(long, conflicts_with = "scene")]
+    resume: Option<PathBuf>,
+    /// Stop after this many seconds of rendering, writing the image so far and a checkpoint
+    /// (--checkpoint, else the output's name with .plf); exit code 3.
+    #[arg(long)]
+    time_limit: Option<f64>,
+    /// Render only pixel samples A to B−1 of every pixel (of --spp), into a film file
+    /// (-o NAME.plf) that `plenum merge` sums with the other ranges' into the image.
+    #[arg(long)]
+    samples: Option<SampleRange>,
     #[command(flatten)]
     view: ViewArgs,
     /// Worker threads (default, or 0: all cores; at most 1024). The image does not depend
@@ -211,6 +254,26 @@ impl std::str::FromStr for IntegratorArg {
                     names.join(", ")
                 )
             })
+    }
+}
+
+/// `--samples A..B`.
+#[derive(Clone, Debug, PartialEq)]
+struct SampleRange(std::ops::Range<u32>);
+
+impl std::str::FromStr for SampleRange {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || format!("expected a range of sample indices A..B (A < B), not `{s}`");
+        let (a, b) = s.split_once("..").ok_or_else(bad)?;
+        let (a, b): (u32, u32) = (
+            a.trim().parse().map_err(|_| bad())?,
+            b.trim().parse().map_err(|_| bad())?,
+        );
+        if a >= b {
+            return Err(bad());
+        }
+        Ok(SampleRange(a..b))
     }
 }
 
@@ -324,6 +387,17 @@ fn whole<T: TryFrom<u64>>(
 const MAX_SIDE: u64 = 1 << 20;
 
 static CANCEL: AtomicBool = AtomicBool::new(false);
+/// Set with [`CANCEL`] when `--time-limit` stopped the render.
+static TIME_UP: AtomicBool = AtomicBool::new(false);
+
+/// The extension of film files: a render's raw state.
+const FILM_EXTENSION: &str = "plf";
+
+fn is_film_file(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case(FILM_EXTENSION))
+}
 
 /// Most worker threads `--threads` takes: far more than any machine's cores, far fewer than
 /// would exhaust the system's threads or memory for their stacks.
@@ -363,6 +437,7 @@ fn main() -> ExitCode {
         Command::TracePixel(args) => trace::run(args),
         Command::Convert(args) => convert(args),
         Command::Bench(args) => bench::run(args),
+        Command::Merge(args) => merge(args),
     }
 }
 
@@ -576,7 +651,117 @@ fn convert(args: ConvertArgs) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-fn run_render(args: RenderArgs) -> ExitCode {
+/// The options `--resume` may be given with: how to run, not what to render.
+const RESUME_OPTIONS: [&str; 5] = [
+    "--threads",
+    "--quiet",
+    "-q",
+    "--time-limit",
+    "--checkpoint-every",
+];
+
+/// The arguments of the render a checkpoint continues: those it was started with (paths
+/// made absolute from the folder it was started in), then those given now.
+fn resumed_args(stored: &[String], cwd: &Path) -> Result<RenderArgs, String> {
+    let mut given = Vec::new();
+    let mut now = std::env::args()
+        .skip(1)
+        .skip_while(|a| a != "render")
+        .skip(1);
+    while let Some(a) = now.next() {
+        if a == "--resume" {
+            now.next();
+            continue;
+        }
+        if a.starts_with("--resume=") {
+            continue;
+        }
+        let name = a.split('=').next().unwrap_or("");
+        if name.starts_with('-') && !RESUME_OPTIONS.contains(&name) {
+            return Err(format!("`{a}` cannot be given with --resume: the render goes on with the scene and settings it was started with; only {} may change", RESUME_OPTIONS.join(", ")));
+        }
+        given.push(a);
+    }
+    let argv = ["plenum", "render"]
+        .into_iter()
+        .map(String::from)
+        .chain(stored.iter().cloned())
+        .chain(given);
+    let mut args = match Cli::try_parse_from(argv) {
+        Ok(Cli {
+            command: Some(Command::Render(a)),
+        }) => a,
+        Ok(_) => return Err("the checkpoint's command line is not a render".to_string()),
+        Err(e) => return Err(format!("the checkpoint's command line: {e}")),
+    };
+    let absolute = |p: &mut PathBuf| {
+        if p.is_relative() && p.as_os_str() != "-" {
+            *p = cwd.join(&*p);
+        }
+    };
+    args.scene.as_mut().map(absolute);
+    absolute(&mut args.output);
+    args.checkpoint.as_mut().map(absolute);
+    args.write_strategies.as_mut().map(absolute);
+    Ok(args)
+}
+
+/// The arguments after `render` as given, less those that belong to this run only, and the
+/// checkpoint's path where it was chosen for the user: what `--resume` starts from.
+fn arguments_to_resume(checkpoint: &Path, given: bool) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut args = std::env::args()
+        .skip(1)
+        .skip_while(|a| a != "render")
+        .skip(1);
+    while let Some(a) = args.next() {
+        if a == "--time-limit" || a == "--resume" {
+            args.next();
+            continue;
+        }
+        if a.starts_with("--time-limit=") || a.starts_with("--resume=") {
+            continue;
+        }
+        out.push(a);
+    }
+    if !given {
+        out.push("--checkpoint".to_string());
+        out.push(checkpoint.to_string_lossy().into_owned());
+    }
+    out
+}
+
+/// FNV-1a of the scene as read, in the native format (which holds every mesh's vertices),
+/// and of its file: a checkpoint goes on only with the scene it was made of.
+fn scene_hash(loaded: &LoadedScene, path: Option<&Path>) -> u64 {
+    let mut h = film_file::Fnv::new();
+    h.update(plenum_scene::to_toml(&loaded.scene, &loaded.defaults).as_bytes());
+    if let Some(bytes) = path.and_then(|p| std::fs::read(p).ok()) {
+        h.update(&bytes);
+    }
+    h.value()
+}
+
+fn run_render(mut args: RenderArgs) -> ExitCode {
+    // --resume: the render's own arguments, and the film it had got to.
+    let mut resumed = None;
+    if let Some(path) = args.resume.take() {
+        let (film, provenance) = match film_file::read(&path) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+        };
+        args = match resumed_args(&provenance.args, &provenance.cwd) {
+            Ok(a) => a,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+        };
+        resumed = Some((path, film, provenance));
+    }
     let load_start = Instant::now();
     let mut loaded = match load(args.scene.as_deref()) {
         Ok(l) => l,
@@ -605,36 +790,102 @@ fn run_render(args: RenderArgs) -> ExitCode {
         Ok(s) => s,
         Err(code) => return code,
     };
+    let refuse = |e: String| {
+        eprintln!("error: {e}");
+        ExitCode::from(2)
+    };
     if let Some(dir) = &args.write_strategies {
         if settings.integrator.kind != IntegratorKind::Bdpt {
-            eprintln!("error: --write-strategies needs --integrator bdpt");
-            return ExitCode::from(2);
+            return refuse("--write-strategies needs --integrator bdpt".to_string());
         }
         settings.integrator.strategies = true;
         if let Err(e) = settings.check() {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
+            return refuse(e);
         }
         if let Err(e) = std::fs::create_dir_all(dir) {
             eprintln!("error: cannot make {}: {e}", dir.display());
             return ExitCode::from(1);
         }
     }
-    if let Err(e) = plenum_image::OutputFormat::from_path(&args.output) {
-        eprintln!("error: {e}");
-        return ExitCode::from(2);
+    let film_output = is_film_file(&args.output);
+    if !film_output {
+        if let Err(e) = plenum_image::OutputFormat::from_path(&args.output) {
+            return refuse(format!("{e} (or .{FILM_EXTENSION}, the raw film)"));
+        }
     }
     // Found now, not after the whole render.
     if let Err(e) = check_writable(&args.output) {
-        eprintln!("error: cannot write {}: {e}", args.output.display());
-        return ExitCode::from(2);
+        return refuse(format!("cannot write {}: {e}", args.output.display()));
     }
     let exposure = args.exposure.unwrap_or(loaded.defaults.exposure);
     if exposure.is_nan() || exposure.abs() > MAX_EXPOSURE {
-        eprintln!("error: --exposure must be a number of stops between -{MAX_EXPOSURE} and {MAX_EXPOSURE}, not {exposure}");
-        return ExitCode::from(2);
+        return refuse(format!("--exposure must be a number of stops between -{MAX_EXPOSURE} and {MAX_EXPOSURE}, not {exposure}"));
     }
     let exposure = exposure as f32;
+
+    // Checkpoints, time limit, sample ranges and film output keep the raw film.
+    let spp = settings.sampler.samples_per_pixel();
+    if let Some(SampleRange(r)) = &args.samples {
+        if r.end > spp {
+            return refuse(format!(
+                "--samples {}..{} reaches beyond the {spp} samples per pixel",
+                r.start, r.end
+            ));
+        }
+        if settings.adaptive.is_some() || settings.corners {
+            return refuse("--samples needs a fixed number of samples per pixel: adaptive sampling and the SPD corners decide per pixel, and cannot be split".to_string());
+        }
+        if !film_output {
+            return refuse(format!("--samples renders a part of the image for `plenum merge`: name the output .{FILM_EXTENSION}, its raw film"));
+        }
+    }
+    if !(args.checkpoint_every > 0.0 && args.checkpoint_every.is_finite()) {
+        return refuse("--checkpoint-every must be a positive number of seconds".to_string());
+    }
+    if let Some(t) = args.time_limit {
+        if !(t > 0.0 && t.is_finite()) {
+            return refuse("--time-limit must be a positive number of seconds".to_string());
+        }
+    }
+    let checkpoint = args.checkpoint.clone().or_else(|| {
+        args.time_limit
+            .map(|_| args.output.with_extension(FILM_EXTENSION))
+    });
+    let keeps_film = checkpoint.is_some() || args.samples.is_some() || film_output;
+    if keeps_film && settings.integrator.kind == IntegratorKind::Sppm {
+        return refuse("integrator `sppm` keeps its state per iteration (radii, photon counts), not per pixel sample: checkpoints, --time-limit, --samples and film output are not available with it".to_string());
+    }
+    if keeps_film && settings.integrator.strategies {
+        return refuse("--write-strategies cannot be combined with checkpoints, --time-limit, --samples or film output: the strategy images are not kept in the film".to_string());
+    }
+    if let Some(c) = &checkpoint {
+        if !is_film_file(c) {
+            return refuse(format!(
+                "--checkpoint: name the checkpoint .{FILM_EXTENSION}, not {}",
+                c.display()
+            ));
+        }
+        if c == &args.output {
+            return refuse("--checkpoint and the output are the same file".to_string());
+        }
+    }
+    let cwd = std::env::current_dir().unwrap_or_default();
+    let provenance = film_file::Provenance {
+        scene: args.scene.clone(),
+        scene_hash: scene_hash(&loaded, args.scene.as_deref()),
+        settings: format!("{settings:?}"),
+        args: match &resumed {
+            Some((_, _, p)) => p.args.clone(),
+            None => arguments_to_resume(
+                checkpoint.as_deref().unwrap_or(Path::new("")),
+                args.checkpoint.is_some(),
+            ),
+        },
+        cwd: match &resumed {
+            Some((_, _, p)) => p.cwd.clone(),
+            None => cwd,
+        },
+    };
     let strategy_images = if settings.integrator.strategies {
         let d = settings.integrator.max_depth as usize;
         (d + 2) * (d + 3) / 2
@@ -652,20 +903,42 @@ fn run_render(args: RenderArgs) -> ExitCode {
         per_pixel,
         memory::available(),
     ) {
-        eprintln!("error: {e}");
-        return ExitCode::from(2);
+        return refuse(e);
     }
+    let samples = args.samples.as_ref().map_or(0..spp, |r| r.0.clone());
+    let mut film = match resumed {
+        Some((path, film, old)) => {
+            if old.scene_hash != provenance.scene_hash {
+                return refuse(format!(
+                    "{} was made of another scene: {} has changed since (or its meshes have)",
+                    path.display(),
+                    args.scene
+                        .as_deref()
+                        .map_or("the built-in scene".into(), |p| p.display().to_string())
+                ));
+            }
+            if old.settings != provenance.settings {
+                return refuse(format!(
+                    "{} was made with other settings:\n  then: {}\n  now:  {}",
+                    path.display(),
+                    old.settings,
+                    provenance.settings
+                ));
+            }
+            film
+        }
+        None => new_film(&settings, samples),
+    };
+
     let threads = args.threads.unwrap_or(0);
     if threads > MAX_THREADS {
-        eprintln!("error: --threads must be at most {MAX_THREADS} (0: all cores), not {threads}");
-        return ExitCode::from(2);
+        return refuse(format!(
+            "--threads must be at most {MAX_THREADS} (0: all cores), not {threads}"
+        ));
     }
     let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
         Ok(p) => p,
-        Err(e) => {
-            eprintln!("error: cannot start {threads} threads: {e}");
-            return ExitCode::from(2);
-        }
+        Err(e) => return refuse(format!("cannot start {threads} threads: {e}")),
     };
     // The first Ctrl-C finishes the tiles in flight and writes the image; a second one
     // ends the process at once.
@@ -674,6 +947,13 @@ fn run_render(args: RenderArgs) -> ExitCode {
             std::process::exit(130);
         }
     });
+    if let Some(t) = args.time_limit {
+        std::thread::spawn(move || {
+            std::thread::sleep(Duration::from_secs_f64(t));
+            TIME_UP.store(true, Ordering::SeqCst);
+            CANCEL.store(true, Ordering::SeqCst);
+        });
+    }
 
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let bar = indicatif::ProgressBar::hidden();
@@ -684,27 +964,61 @@ fn run_render(args: RenderArgs) -> ExitCode {
                 .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
     }
-    let start = Instant::now();
-    let output = pool.install(|| {
-        render(&loaded.scene, &settings, &CANCEL, &|done, total| {
-            if show_progress {
-                bar.set_length(total as u64);
-                bar.set_position(done as u64);
+    let save = |film: &RawFilm| -> bool {
+        let Some(path) = &checkpoint else { return true };
+        match film_file::write(path, film, &provenance) {
+            Ok(()) => true,
+            Err(e) => {
+                eprintln!(
+                    "warning: cannot write the checkpoint {}: {e}",
+                    path.display()
+                );
+                false
             }
-        })
+        }
+    };
+    let mut periodic = |film: &RawFilm| {
+        save(film);
+    };
+    let start = Instant::now();
+    let progress = |done: usize, total: usize| {
+        if show_progress {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        }
+    };
+    let output = pool.install(|| {
+        if settings.integrator.kind == IntegratorKind::Sppm {
+            return render(&loaded.scene, &settings, &CANCEL, &progress);
+        }
+        let control = RenderControl {
+            cancel: &CANCEL,
+            progress: &progress,
+            checkpoint: checkpoint.as_ref().map(|_| {
+                (
+                    Duration::from_secs_f64(args.checkpoint_every),
+                    &mut periodic as &mut dyn FnMut(&RawFilm),
+                )
+            }),
+        };
+        render_film(&loaded.scene, &settings, &mut film, control)
     });
     let elapsed = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
-    let film = &output.film;
-    if let Err(e) = plenum_image::write_image(
-        &args.output,
-        film.width,
-        film.height,
-        film.pixels(),
-        exposure,
-    ) {
+    let written = if film_output {
+        film_file::write(&args.output, &film, &provenance)
+            .map_err(|e| format!("cannot write {}: {e}", args.output.display()))
+    } else {
+        let f = &output.film;
+        plenum_image::write_image(&args.output, f.width, f.height, f.pixels(), exposure)
+            .map_err(|e| e.to_string())
+    };
+    if let Err(e) = written {
         eprintln!("error: {e}");
+        if !output.complete {
+            save(&film);
+        }
         return ExitCode::from(1);
     }
     if let Some(dir) = &args.write_strategies {
@@ -729,18 +1043,21 @@ fn run_render(args: RenderArgs) -> ExitCode {
             }
         }
     }
+    let film_image = &output.film;
     if !args.quiet {
         let c = &output.counts;
         eprintln!(
             "loaded in {:.3} s; {}×{}, {}, {:.3} s, {} ({}), rays: {}; {:.2} Mrays/s → {}",
             load_seconds,
-            film.width,
-            film.height,
-            match settings.adaptive {
-                None => format!("{} spp", settings.sampler.samples_per_pixel()),
-                Some(_) => format!(
+            film_image.width,
+            film_image.height,
+            match (settings.adaptive, &args.samples) {
+                (None, None) => format!("{} spp", spp),
+                (None, Some(SampleRange(r))) =>
+                    format!("samples {}..{} of {spp} per pixel", r.start, r.end),
+                (Some(_), _) => format!(
                     "{:.2} spp on average (adaptive)",
-                    c.camera as f64 / (film.width as f64 * film.height as f64)
+                    c.camera as f64 / (film_image.width as f64 * film_image.height as f64)
                 ),
             },
             elapsed,
@@ -764,11 +1081,120 @@ fn run_render(args: RenderArgs) -> ExitCode {
         );
     }
     if !output.complete {
+        let stopped = if TIME_UP.load(Ordering::SeqCst) {
+            "the time limit was reached"
+        } else {
+            "interrupted"
+        };
         eprintln!(
-            "interrupted: wrote the part rendered so far to {}",
+            "{stopped}: wrote the part rendered so far to {}",
             args.output.display()
         );
-        return ExitCode::from(130);
+        if let Some(path) = &checkpoint {
+            if save(&film) {
+                eprintln!(
+                    "the render's state is in {}: continue it with `plenum render --resume {}`",
+                    path.display(),
+                    path.display()
+                );
+            }
+        }
+        return ExitCode::from(if TIME_UP.load(Ordering::SeqCst) {
+            3
+        } else {
+            130
+        });
+    }
+    // Done: the image holds everything the checkpoint did.
+    if let Some(path) = &checkpoint {
+        let _ = std::fs::remove_file(path);
     }
     ExitCode::SUCCESS
+}
+
+/// `plenum merge`: the parts' films summed in the order of their sample ranges.
+fn merge(args: MergeArgs) -> ExitCode {
+    let refuse = |e: String| {
+        eprintln!("error: {e}");
+        ExitCode::from(2)
+    };
+    let film_output = is_film_file(&args.output);
+    if !film_output {
+        if let Err(e) = plenum_image::OutputFormat::from_path(&args.output) {
+            return refuse(format!("{e} (or .{FILM_EXTENSION}, the raw film)"));
+        }
+    }
+    let exposure = args.exposure.unwrap_or(0.0);
+    if exposure.is_nan() || exposure.abs() > MAX_EXPOSURE {
+        return refuse(format!("--exposure must be a number of stops between -{MAX_EXPOSURE} and {MAX_EXPOSURE}, not {exposure}"));
+    }
+    let mut parts = Vec::new();
+    let mut first: Option<(PathBuf, film_file::Provenance)> = None;
+    for path in &args.parts {
+        let (film, p) = match film_file::read(path) {
+            Ok(r) => r,
+            Err(e) => return refuse(e),
+        };
+        if let Some((first_path, f)) = &first {
+            if p.scene_hash != f.scene_hash {
+                return refuse(format!(
+                    "{} and {} were rendered from different scenes",
+                    first_path.display(),
+                    path.display()
+                ));
+            }
+            if p.settings != f.settings {
+                return refuse(format!(
+                    "{} and {} were rendered with different settings:\n  {}\n  {}",
+                    first_path.display(),
+                    path.display(),
+                    f.settings,
+                    p.settings
+                ));
+            }
+        } else {
+            if p.settings.contains("adaptive: Some") {
+                return refuse(format!("{} was rendered with adaptive sampling, which decides per pixel how many samples to take: it cannot be split or merged", path.display()));
+            }
+            first = Some((path.clone(), p));
+        }
+        parts.push(film);
+    }
+    let Some((_, provenance)) = first else {
+        return refuse("nothing to merge".to_string());
+    };
+    let film = match RawFilm::merge(parts) {
+        Ok(f) => f,
+        Err(e) => return refuse(e),
+    };
+    if film.samples != (0..film.spp) {
+        eprintln!(
+            "warning: the parts hold samples {}..{} of the {} per pixel: the image has the noise of {} samples",
+            film.samples.start,
+            film.samples.end,
+            film.spp,
+            film.samples.len()
+        );
+    }
+    let written = if film_output {
+        film_file::write(&args.output, &film, &provenance)
+            .map_err(|e| format!("cannot write {}: {e}", args.output.display()))
+    } else {
+        let image = film.image();
+        plenum_image::write_image(
+            &args.output,
+            image.width,
+            image.height,
+            image.pixels(),
+            exposure as f32,
+        )
+        .map_err(|e| e.to_string())
+    };
+    match written {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(1)
+        }
+    }
 }

@@ -6,16 +6,17 @@
 use plenum_core::integrator::IntegratorKind;
 
 /// Bytes per pixel a render allocates, by what it keeps per pixel, measured as peak resident
-/// memory over 1024² pixels (December 2026) and rounded up by a quarter: the film's sums
-/// and resolved pixels (68 bytes), splats in fixed point (light tracing, BDPT), SPPM's
-/// visible points, the per-pass films of adaptive sampling.
+/// memory over 1024² pixels (December 2026) and rounded up by a quarter: the raw film's
+/// exact sums (145 bytes) and the image resolved from it (68), splats in fixed point (light
+/// tracing, BDPT: the buffer, the film's copy and the copy made at a checkpoint), SPPM's
+/// visible points, adaptive sampling's open flags.
 pub fn bytes_per_pixel(kind: IntegratorKind, adaptive: bool, strategy_images: usize) -> u64 {
     let base = match kind {
         IntegratorKind::Sppm => 610,
-        IntegratorKind::Light | IntegratorKind::Bdpt => 118,
-        _ => 70,
+        IntegratorKind::Light | IntegratorKind::Bdpt => 290,
+        _ => 215,
     };
-    let adaptive = if adaptive { 75 } else { 0 };
+    let adaptive = if adaptive { 2 } else { 0 };
     // BDPT's strategy images: two films each (weighted and unweighted).
     let strategies = strategy_images as u64 * 2 * 68;
     (base + adaptive + strategies) * 5 / 4
@@ -117,10 +118,10 @@ mod tests {
     fn a_film_larger_than_what_is_available_is_refused() {
         let per_pixel = bytes_per_pixel(IntegratorKind::Whitted, false, 0);
         let four_gb = Some((4u64 << 30, "a test"));
-        // 16384² pixels, the largest size accepted, need some 21 GiB.
+        // 16384² pixels, the largest size accepted, need some 67 GiB.
         let e = check(16384, 16384, per_pixel, four_gb).unwrap_err();
         assert!(e.contains("16384×16384") && e.contains("4.00 GiB"), "{e}");
-        assert!(check(4096, 4096, per_pixel, four_gb).is_ok());
+        assert!(check(3072, 3072, per_pixel, four_gb).is_ok());
         assert!(check(16384, 16384, per_pixel, None).is_ok());
         // SPPM keeps far more per pixel.
         let sppm = bytes_per_pixel(IntegratorKind::Sppm, false, 0);

@@ -782,3 +782,416 @@ fn a_newcomers_mistakes_get_clear_answers() {
     let o = run(&[&["render"][..], &small].concat());
     assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
 }
+
+/// The Cornell box at a size that takes about a second on one thread.
+fn cornell_args(size: &str, spp: &str) -> Vec<String> {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
+    [
+        scene.to_str().unwrap(),
+        "--width",
+        size,
+        "--height",
+        size,
+        "--spp",
+        spp,
+        "--color",
+        "rgb",
+        "--threads",
+        "1",
+        "--quiet",
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
+/// A render killed with SIGKILL at random moments (seeded; checkpoints every 50 ms, so some
+/// kills land while one is being written) and resumed each time from its last checkpoint
+/// ends with the same bytes as a render never stopped, and removes its checkpoint.
+#[cfg(unix)]
+#[test]
+fn a_render_killed_at_random_moments_resumes_to_the_same_bytes() {
+    let tmp = temp_dir("kill");
+    let dir = tmp.path();
+    let args = cornell_args("128", "96");
+    let o = plenum()
+        .current_dir(dir)
+        .arg("render")
+        .args(&args)
+        .args(["-o", "reference.pfm"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let reference = std::fs::read(dir.join("reference.pfm")).unwrap();
+
+    let checkpoint = dir.join("state.plf");
+    let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut random = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let (mut kills, mut resumes) = (0, 0);
+    loop {
+        let mut command = plenum();
+        command.current_dir(dir).arg("render");
+        if checkpoint.exists() {
+            resumes += 1;
+            command.args(["--resume", "state.plf"]);
+        } else {
+            command.args(&args).args([
+                "--checkpoint",
+                "state.plf",
+                "--checkpoint-every",
+                "0.05",
+                "-o",
+                "out.pfm",
+            ]);
+        }
+        let mut child = command
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        if kills < 5 {
+            std::thread::sleep(std::time::Duration::from_millis(150 + random() % 350));
+            if child.try_wait().unwrap().is_none() {
+                child.kill().unwrap();
+                child.wait().unwrap();
+                kills += 1;
+                continue;
+            }
+        }
+        let o = child.wait_with_output().unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        break;
+    }
+    assert!(
+        kills >= 3 && resumes >= 2,
+        "{kills} kills, {resumes} resumes"
+    );
+    let out = std::fs::read(dir.join("out.pfm")).unwrap();
+    assert!(
+        out == reference,
+        "the resumed image differs from the uninterrupted one"
+    );
+    assert!(
+        !checkpoint.exists(),
+        "the checkpoint is removed once the image is written"
+    );
+}
+
+/// --time-limit stops with an image, a checkpoint and exit code 3; --resume finishes it to
+/// the bytes of one render. A checkpoint is refused, exit 2, when damaged, when its scene has
+/// changed, or when other settings are asked for.
+#[test]
+fn checkpoints_stop_resume_and_refuse_what_does_not_match() {
+    let tmp = temp_dir("checkpoint");
+    let dir = tmp.path();
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml"),
+    )
+    .unwrap();
+    let scene = write(dir, "box.toml", &text);
+    let mut args = cornell_args("128", "64");
+    args[0] = "box.toml".to_string();
+    let run = |extra: &[&str]| {
+        plenum()
+            .current_dir(dir)
+            .arg("render")
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = run(&[
+        &args.iter().map(String::as_str).collect::<Vec<_>>()[..],
+        &["-o", "reference.pfm"],
+    ]
+    .concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let reference = std::fs::read(dir.join("reference.pfm")).unwrap();
+
+    let started = [
+        &args.iter().map(String::as_str).collect::<Vec<_>>()[..],
+        &["-o", "out.pfm", "--time-limit", "0.3"],
+    ]
+    .concat();
+    let o = run(&started);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("time limit") && e.contains("--resume"), "{e}");
+    let checkpoint = dir.join("out.plf");
+    assert!(checkpoint.exists() && dir.join("out.pfm").exists());
+    let saved = std::fs::read(&checkpoint).unwrap();
+
+    // Refused: other settings, a damaged file, a file that is not a film, another scene.
+    let refused = |extra: &[&str], says: &str| {
+        let o = run(extra);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
+    };
+    refused(
+        &["--resume", "out.plf", "--spp", "32"],
+        "cannot be given with --resume",
+    );
+    let mut damaged = saved.clone();
+    let middle = damaged.len() / 2;
+    damaged[middle] ^= 1;
+    std::fs::write(dir.join("damaged.plf"), &damaged).unwrap();
+    refused(&["--resume", "damaged.plf"], "checksum does not match");
+    std::fs::write(dir.join("short.plf"), &saved[..saved.len() - 100]).unwrap();
+    refused(&["--resume", "short.plf"], "checksum does not match");
+    refused(&["--resume", "box.toml"], "not a Plenum film file");
+    std::fs::write(&scene, text.replace("spp = ", "# changed\nspp = ")).unwrap();
+    refused(&["--resume", "out.plf"], "another scene");
+    std::fs::write(&scene, &text).unwrap();
+
+    // Resumed (from another folder: its paths are the ones it was started with).
+    let o = plenum()
+        .current_dir(std::env::temp_dir())
+        .args(["render", "--resume"])
+        .arg(&checkpoint)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::read(dir.join("out.pfm")).unwrap() == reference);
+    assert!(!checkpoint.exists());
+
+    // What keeps no film per pixel sample is refused.
+    refused(&["--integrator", "sppm", "--checkpoint", "x.plf"], "sppm");
+    refused(&["--checkpoint", "x.png"], "name the checkpoint .plf");
+}
+
+/// Sample ranges rendered apart (as a farm's tasks would) and merged give the bytes of one
+/// render, for the path tracer and for light tracing, whose splats land in other pixels;
+/// overlaps, gaps, other settings and adaptive sampling are refused.
+#[test]
+fn sample_ranges_merge_to_the_bytes_of_one_render() {
+    let tmp = temp_dir("merge");
+    let dir = tmp.path();
+    let run = |args: &[String], extra: &[&str]| {
+        plenum()
+            .current_dir(dir)
+            .arg("render")
+            .args(args)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let merge = |extra: &[&str]| {
+        plenum()
+            .current_dir(dir)
+            .arg("merge")
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    for method in ["path", "light"] {
+        let mut args = cornell_args("40", "12");
+        args.extend(["--integrator", method, "--filter", "mitchell"].map(String::from));
+        let o = run(&args, &["-o", "whole.pfm"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        for (range, name) in [("0..5", "a.plf"), ("5..6", "b.plf"), ("6..12", "c.plf")] {
+            let o = run(&args, &["--samples", range, "-o", name]);
+            assert!(o.status.success(), "{}", stderr(&o));
+        }
+        let o = merge(&["c.plf", "a.plf", "b.plf", "-o", "merged.pfm"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(
+            std::fs::read(dir.join("merged.pfm")).unwrap()
+                == std::fs::read(dir.join("whole.pfm")).unwrap(),
+            "{method}: merged parts differ from one render"
+        );
+        // Merged in two levels: a film of films.
+        let o = merge(&["a.plf", "b.plf", "-o", "ab.plf"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let o = merge(&["ab.plf", "c.plf", "-o", "merged2.pfm"]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(
+            std::fs::read(dir.join("merged2.pfm")).unwrap()
+                == std::fs::read(dir.join("whole.pfm")).unwrap()
+        );
+
+        let refused = |o: Output, says: &str| {
+            assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+            assert!(stderr(&o).contains(says), "{}", stderr(&o));
+        };
+        refused(
+            merge(&["a.plf", "c.plf", "-o", "x.pfm"]),
+            "5..6 are missing",
+        );
+        refused(merge(&["a.plf", "ab.plf", "-o", "x.pfm"]), "overlap");
+        let o = run(
+            &args,
+            &["--samples", "5..6", "--seed", "7", "-o", "other.plf"],
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        refused(
+            merge(&["a.plf", "other.plf", "c.plf", "-o", "x.pfm"]),
+            "different settings",
+        );
+        refused(
+            run(&args, &["--samples", "0..13", "-o", "x.plf"]),
+            "beyond the 12 samples",
+        );
+        refused(
+            run(&args, &["--samples", "0..4", "-o", "x.png"]),
+            "name the output .plf",
+        );
+    }
+    let args = cornell_args("40", "12");
+    let o = run(
+        &args,
+        &["--sampler", "adaptive", "--samples", "0..4", "-o", "x.plf"],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("adaptive"), "{}", stderr(&o));
+}
+
+/// Whether the farm tests must run (`.ci/run` sets it, having installed Slurm and Dask):
+/// then a missing tool fails them instead of skipping them.
+fn farm_required() -> bool {
+    std::env::var("PLENUM_REQUIRE_FARM").is_ok_and(|v| v == "1")
+}
+
+fn skip_farm(what: &str) {
+    assert!(!farm_required(), "{what} (PLENUM_REQUIRE_FARM=1)");
+    eprintln!("skipped: {what}");
+}
+
+/// Stops the one-node cluster when the test ends, passed or not.
+struct Cluster(PathBuf);
+
+impl Drop for Cluster {
+    fn drop(&mut self) {
+        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../farm/one-node-cluster.sh");
+        let _ = Command::new("bash")
+            .arg(script)
+            .arg("stop")
+            .arg(&self.0)
+            .output();
+    }
+}
+
+/// The farm scripts end to end: a Slurm job array on a one-node cluster the test starts
+/// itself (munged, slurmctld, slurmd), then its merge job (afterok); and a Dask local
+/// cluster. Each merged image has the bytes of one render.
+#[test]
+fn slurm_and_dask_renders_merge_to_the_bytes_of_one_render() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let farm = root.join("farm");
+    let tmp = temp_dir("farm");
+    let dir = tmp.path();
+    let bin = env!("CARGO_BIN_EXE_plenum");
+    let scene = root.join("scenes/cornell-box.toml");
+    let options = [
+        "--width",
+        "48",
+        "--height",
+        "48",
+        "--color",
+        "rgb",
+        "--integrator",
+        "bdpt",
+        "--threads",
+        "1",
+    ];
+    let o = plenum()
+        .arg("render")
+        .arg(&scene)
+        .args(["--spp", "12", "--quiet", "-o"])
+        .arg(dir.join("one.pfm"))
+        .args(options)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let one = std::fs::read(dir.join("one.pfm")).unwrap();
+
+    let root_user = Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| o.stdout.starts_with(b"0\n"));
+    let have = |p: &str| {
+        Path::new("/usr/sbin").join(p).exists()
+            || Command::new("which")
+                .arg(p)
+                .output()
+                .is_ok_and(|o| o.status.success())
+    };
+    if !(root_user && have("slurmctld") && have("slurmd") && have("munged") && have("sbatch")) {
+        skip_farm("Slurm (slurm-wlm, munge, as root) is not here");
+    } else {
+        let cluster_dir = dir.join("cluster");
+        let o = Command::new("bash")
+            .arg(farm.join("one-node-cluster.sh"))
+            .arg("start")
+            .arg(&cluster_dir)
+            .output()
+            .unwrap();
+        let _cluster = Cluster(cluster_dir.clone());
+        assert!(
+            o.status.success(),
+            "the cluster did not start: {}",
+            stderr(&o)
+        );
+        let o = Command::new("bash")
+            .env("SLURM_CONF", cluster_dir.join("slurm.conf"))
+            .current_dir(dir)
+            .arg(farm.join("slurm-render.sh"))
+            .args(["-w", "-p", "3", "-b", bin])
+            .arg(&scene)
+            .args(["slurm.pfm", "12"])
+            .args(options)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            stderr(&o)
+        );
+        assert!(String::from_utf8_lossy(&o.stdout).contains("3 parts"));
+        assert!(
+            std::fs::read(dir.join("slurm.pfm")).unwrap() == one,
+            "Slurm's merged image differs"
+        );
+        for i in 0..3 {
+            assert!(dir.join(format!("slurm.parts/part-{i}.plf")).exists());
+        }
+    }
+
+    let dask = Command::new("python3")
+        .args(["-c", "import dask.distributed"])
+        .output();
+    if !dask.is_ok_and(|o| o.status.success()) {
+        skip_farm("Dask (pip dask[distributed]) is not here");
+    } else {
+        let o = Command::new("python3")
+            .current_dir(dir)
+            .arg(farm.join("dask_render.py"))
+            .arg(&scene)
+            .args([
+                "dask.pfm",
+                "12",
+                "--parts",
+                "4",
+                "--workers",
+                "2",
+                "--plenum",
+                bin,
+                "--",
+            ])
+            .args(options)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{}{}",
+            String::from_utf8_lossy(&o.stdout),
+            stderr(&o)
+        );
+        assert!(
+            std::fs::read(dir.join("dask.pfm")).unwrap() == one,
+            "Dask's merged image differs"
+        );
+    }
+}

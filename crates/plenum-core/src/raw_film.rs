@@ -111,9 +111,12 @@ pub struct RawFilm {
     /// The sample indices this film is to hold of every pixel (a fixed-count render);
     /// pixel p holds `samples.start .. samples.start + count`.
     pub samples: Range<u32>,
+    /// The samples per pixel of the whole render, `samples` being part of them: the
+    /// splats were divided by it.
+    pub spp: u32,
     pub pixels: Vec<PixelSums>,
-    /// Per pixel, the passes finished: a fixed-count render does not use them (its counts
-    /// tell); adaptive subdivision and corners finish in 1, sampling by variance in 2.
+    /// Per pixel, the passes finished: a pixel is done after 1 (after 2 when sampling by
+    /// variance). Tiles are rendered whole, so a checkpoint holds whole tiles.
     pub stages: Vec<u8>,
     /// Sampling by variance, once its first pass is done: the pixels not converged after it.
     pub open: Vec<bool>,
@@ -129,6 +132,7 @@ impl RawFilm {
             width,
             height,
             corners,
+            spp: samples.end,
             samples,
             pixels: vec![PixelSums::default(); n],
             stages: vec![0; n],
@@ -137,14 +141,14 @@ impl RawFilm {
         }
     }
 
-    /// Whether every pixel holds all the samples of its range (a fixed-count render).
-    pub fn has_all_samples(&self) -> bool {
-        let n = self.samples.len() as u32;
-        self.pixels.iter().all(|p| p.count == n)
+    /// Whether every pixel has finished `passes` passes.
+    pub fn is_complete(&self, passes: u8) -> bool {
+        self.stages.iter().all(|&s| s >= passes)
     }
 
     /// The image: each pixel's weighted mean plus its splats; for a corner grid, each pixel
-    /// the mean of its four corners.
+    /// the mean of its four corners. Splats were divided by the whole render's samples per
+    /// pixel; a film of part of them is scaled up to its own.
     pub fn image(&self) -> Film {
         let mut film = Film::new(self.width, self.height);
         for y in 0..self.height {
@@ -156,7 +160,12 @@ impl RawFilm {
         if !self.splats.is_empty() {
             film.add_splat_sums(&self.splats);
         }
-        film.resolve(1.0);
+        let held = self.samples.len() as f64;
+        film.resolve(if held > 0.0 {
+            self.spp as f64 / held
+        } else {
+            1.0
+        });
         if !self.corners {
             return film;
         }
@@ -182,8 +191,14 @@ impl RawFilm {
         let Some(mut sum) = parts.next() else {
             return Err("nothing to merge".to_string());
         };
-        if sum.corners || !sum.open.is_empty() || sum.stages.iter().any(|&s| s != 0) {
+        if sum.corners || !sum.open.is_empty() {
             return Err("only renders with a fixed number of samples per pixel can be merged (not adaptive sampling or the SPD corners)".to_string());
+        }
+        if !sum.is_complete(1) {
+            return Err(format!(
+                "the part of samples {}..{} is not finished: resume it first",
+                sum.samples.start, sum.samples.end
+            ));
         }
         for part in parts {
             let (a, b) = (&sum.samples, &part.samples);
@@ -207,9 +222,16 @@ impl RawFilm {
             }
             if part.splats.len() != sum.splats.len()
                 || part.corners
-                || part.stages.iter().any(|&s| s != 0)
+                || !part.open.is_empty()
+                || part.spp != sum.spp
             {
                 return Err("the parts were rendered differently".to_string());
+            }
+            if !part.is_complete(1) {
+                return Err(format!(
+                    "the part of samples {}..{} is not finished: resume it first",
+                    b.start, b.end
+                ));
             }
             for (s, p) in sum.pixels.iter_mut().zip(&part.pixels) {
                 s.merge(p);
@@ -254,6 +276,8 @@ mod tests {
             samples[range]
                 .iter()
                 .for_each(|&(c, w)| film.pixels[0].add(c, w));
+            film.stages[0] = 1;
+            film.spp = 200;
             parts.push(film);
         }
         parts.swap(0, 2);
@@ -275,12 +299,21 @@ mod tests {
 
     #[test]
     fn merge_refuses_overlaps_and_gaps() {
-        let part = |r: Range<u32>| RawFilm::new(2, 2, false, r);
+        let part = |r: Range<u32>| {
+            let mut f = RawFilm::new(2, 2, false, r);
+            f.stages.fill(1);
+            f.spp = 8;
+            f
+        };
         let e = RawFilm::merge(vec![part(0..4), part(3..8)]).unwrap_err();
         assert!(e.contains("overlap"), "{e}");
         let e = RawFilm::merge(vec![part(0..4), part(5..8)]).unwrap_err();
         assert!(e.contains("4..5 are missing"), "{e}");
         let e = RawFilm::merge(vec![part(0..4), RawFilm::new(2, 3, false, 4..8)]).unwrap_err();
         assert!(e.contains("size"), "{e}");
+        let mut unfinished = part(4..8);
+        unfinished.stages[3] = 0;
+        let e = RawFilm::merge(vec![part(0..4), unfinished]).unwrap_err();
+        assert!(e.contains("4..8 is not finished"), "{e}");
     }
 }

@@ -8,19 +8,24 @@
 //!
 //! **Invariant:** the image depends only on the scene, the settings and the seed. Every pixel
 //! is computed from its own samples whose random streams come from (seed, pixel, sample), and
-//! tiles are written back by position, so the thread count changes nothing.
+//! tiles are written back by position, so the thread count changes nothing. Pixels sum their
+//! samples in fixed point ([`RawFilm`]), so a render stopped and continued from a checkpoint,
+//! or split into sample ranges and merged, gives the same bytes as one uninterrupted render.
 
 use crate::camera::Camera;
 use crate::color::Color;
-use crate::film::{Film, SplatBuffer};
+use crate::film::SplatBuffer;
 use crate::integrator::{
     Integrator, IntegratorConfig, IntegratorKind, RayCounts, RayTree, StrategyImages,
 };
+use crate::raw_film::{PixelSums, RawFilm};
 use crate::sampling::{Filter, PixelSampler, Rng, SampleStream};
 use crate::scene::Scene;
 use rayon::prelude::*;
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
+use std::time::{Duration, Instant};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
@@ -118,13 +123,41 @@ pub const TILE_SIZE: u32 = 16;
 
 #[derive(Clone, Debug)]
 pub struct RenderOutput {
-    pub film: Film,
+    pub film: crate::film::Film,
     pub counts: RayCounts,
     /// False when the render was cancelled: tiles not yet rendered are black.
     pub complete: bool,
     /// Bidirectional path tracing with `strategies` set: for each strategy (s, t), its
     /// image weighted by MIS and unweighted.
-    pub strategies: Vec<(usize, usize, Film, Film)>,
+    pub strategies: Vec<(usize, usize, crate::film::Film, crate::film::Film)>,
+}
+
+/// What the caller of [`render_film`] may do while it runs.
+pub struct RenderControl<'a> {
+    /// Set: the render stops between tiles (the film keeps what is done).
+    pub cancel: &'a AtomicBool,
+    /// Called after each tile with (tiles done, tiles in all).
+    pub progress: &'a (dyn Fn(usize, usize) + Sync),
+    /// Every so often, between tiles with none in flight, the film so far: what a
+    /// checkpoint saves.
+    pub checkpoint: Option<(Duration, &'a mut dyn FnMut(&RawFilm))>,
+}
+
+/// An empty film for `settings`, to hold sample indices `samples` of every pixel (of all
+/// `settings.sampler`'s samples; ignored by adaptive sampling and the SPD corners).
+pub fn new_film(settings: &RenderSettings, samples: Range<u32>) -> RawFilm {
+    let extra = u32::from(settings.corners);
+    let mut film = RawFilm::new(
+        settings.width + extra,
+        settings.height + extra,
+        settings.corners,
+        samples,
+    );
+    film.spp = settings.sampler.samples_per_pixel();
+    if settings.integrator.kind.splats() {
+        film.splats = vec![[0; 3]; settings.width as usize * settings.height as usize];
+    }
+    film
 }
 
 /// Renders the scene. `cancel` stops the render between tiles; `progress(done, total)` is
@@ -139,21 +172,39 @@ pub fn render(
     if settings.integrator.kind == IntegratorKind::Sppm {
         return crate::integrator::sppm::render(scene, settings, cancel, progress);
     }
+    let mut film = new_film(settings, 0..settings.sampler.samples_per_pixel());
+    let control = RenderControl {
+        cancel,
+        progress,
+        checkpoint: None,
+    };
+    render_film(scene, settings, &mut film, control)
+}
+
+/// Renders into `film` (from [`new_film`], or a checkpoint of the same scene and settings):
+/// the pixels it does not yet hold in full, then the image of all it holds. Not for SPPM,
+/// whose state is per iteration, not per pixel sample.
+pub fn render_film(
+    scene: &Scene,
+    settings: &RenderSettings,
+    film: &mut RawFilm,
+    mut control: RenderControl,
+) -> RenderOutput {
     // Splats are pixel values once divided by the light paths per pixel; the camera's
     // importance reaches as far beyond the image as the filter spreads them.
+    let spp = settings.sampler.samples_per_pixel().max(1);
     let splats = if settings.integrator.kind.splats() {
-        let spp = settings.sampler.samples_per_pixel().max(1);
         SplatBuffer::new(settings.width, settings.height, 1.0 / spp as f64)
             .with_filter(&settings.filter)
     } else {
         SplatBuffer::new(0, 0, 0.0)
     };
+    splats.preload(&film.splats);
     let camera =
         Camera::new(&scene.camera, settings.width, settings.height).with_margin(splats.margin());
     let strategies = (settings.integrator.strategies
         && settings.integrator.kind == IntegratorKind::Bdpt)
         .then(|| {
-            let spp = settings.sampler.samples_per_pixel().max(1);
             StrategyImages::new(
                 settings.width,
                 settings.height,
@@ -169,86 +220,104 @@ pub fn render(
         strategies.as_ref(),
         settings.seed,
     );
-    // In corner mode the grid rendered is that of the corners, one ray each.
-    let extra = u32::from(settings.corners);
-    let (w, h) = (settings.width + extra, settings.height + extra);
+    let (w, h) = (film.width, film.height);
     let passes = if let Some(Adaptive::Variance { .. }) = settings.adaptive {
         2
     } else {
         1
     };
-    let tiles = Tiles {
+    let mut tiles = Tiles {
         width: w,
         height: h,
-        cancel,
-        progress,
+        cancel: control.cancel,
+        progress: control.progress,
         passes,
+        checkpoint: control.checkpoint.take(),
     };
     let mut counts = integrator.pass_counts();
-    let (colors, complete) = match settings.adaptive {
+    let samples = film.samples.clone();
+    let complete = match settings.adaptive {
         Some(Adaptive::Variance {
             threshold, min_spp, ..
         }) => {
             // First pass: min_spp samples everywhere. Second: more where the pixel or a
             // neighbour is not yet converged (a pixel whose first samples all missed a
             // nearby edge looks converged on its own; its neighbour gives it away).
-            let (first, done) = tiles.run(0, &mut counts, |x, y, c| {
-                let mut e = PixelEstimate::default();
+            let first = tiles.run(0, film, &splats, &mut counts, |x, y, sums, c| {
                 sample_pixel(
                     &integrator,
                     &camera,
                     settings,
                     (x, y),
                     0..min_spp,
-                    &mut e,
+                    sums,
                     c,
                     None,
                 );
-                e
             });
-            let open: Vec<bool> = first.iter().map(|e| !e.converged(threshold)).collect();
-            let near_open = |x: u32, y: u32| {
-                let (x0, x1) = (x.saturating_sub(1), (x + 1).min(w - 1));
-                let (y0, y1) = (y.saturating_sub(1), (y + 1).min(h - 1));
-                (y0..=y1).any(|j| (x0..=x1).any(|i| open[(j * w + i) as usize]))
-            };
-            let (refined, rest) = tiles.run(1, &mut counts, |x, y, c| {
-                let mut e = first[(y * w + x) as usize].clone();
-                if done && near_open(x, y) {
-                    refine_pixel(&integrator, &camera, settings, (x, y), &mut e, c, None);
+            first && {
+                if film.open.is_empty() {
+                    film.open = film
+                        .pixels
+                        .iter()
+                        .map(|p| !p.converged(threshold))
+                        .collect();
                 }
-                Some(e.value())
-            });
-            // Tiles a cancel kept from the second pass keep what the first one found.
-            let colors = refined
-                .iter()
-                .zip(&first)
-                .map(|(r, f)| r.unwrap_or_else(|| f.value()))
-                .collect();
-            (colors, done && rest)
+                // Kept in the film too: a checkpoint in the second pass must know which
+                // pixels the first left open, which their refined sums no longer tell.
+                let open = film.open.clone();
+                let near_open = |x: u32, y: u32| {
+                    let (x0, x1) = (x.saturating_sub(1), (x + 1).min(w - 1));
+                    let (y0, y1) = (y.saturating_sub(1), (y + 1).min(h - 1));
+                    (y0..=y1).any(|j| (x0..=x1).any(|i| open[(j * w + i) as usize]))
+                };
+                // Pixels a cancel kept from the second pass keep what the first found.
+                let second = tiles.run(1, film, &splats, &mut counts, |x, y, sums, c| {
+                    if near_open(x, y) {
+                        refine_pixel(&integrator, &camera, settings, (x, y), sums, c, None);
+                    }
+                });
+                second
+            }
         }
-        _ => tiles.run(0, &mut counts, |x, y, c| {
+        _ => tiles.run(0, film, &splats, &mut counts, |x, y, sums, c| {
             if settings.corners {
                 let mut stream = corner_stream(settings.seed, x, y);
                 let ray = camera.ray(x as f64, y as f64);
-                integrator.camera_ray(&ray, &mut stream, c, None)
+                *sums = PixelSums::single(integrator.camera_ray(&ray, &mut stream, c, None));
+            } else if let Some(Adaptive::Subdivide { contrast, depth }) = settings.adaptive {
+                *sums = PixelSums::single(subdivide_pixel(
+                    &integrator,
+                    &camera,
+                    settings,
+                    (x, y),
+                    contrast,
+                    depth,
+                    c,
+                    None,
+                ));
             } else {
-                render_pixel(&integrator, &camera, settings, x, y, c, None)
+                let indices = samples.clone();
+                sample_pixel(
+                    &integrator,
+                    &camera,
+                    settings,
+                    (x, y),
+                    indices,
+                    sums,
+                    c,
+                    None,
+                );
             }
         }),
     };
-    let mut film = Film::new(w, h);
-    for y in 0..h {
-        for x in 0..w {
-            film.set(x, y, colors[(y * w + x) as usize]);
-        }
+    if !film.splats.is_empty() {
+        film.splats = splats.sums();
     }
-    film.add_splats(&splats);
-    film.resolve(1.0);
     counts.invalid += splats.clamped();
     let strategies = strategies.map_or_else(Vec::new, |si| {
         let film_of = |b: &SplatBuffer| {
-            let mut f = Film::new(settings.width, settings.height);
+            let mut f = crate::film::Film::new(settings.width, settings.height);
             f.add_splats(b);
             f.resolve(1.0);
             f
@@ -262,93 +331,121 @@ pub fn render(
     });
     RenderOutput {
         strategies,
-        film: if settings.corners {
-            average_corners(&film)
-        } else {
-            film
-        },
+        film: film.image(),
         counts,
         complete,
     }
 }
 
-/// The image cut into tiles, rendered in parallel, pass after pass.
+/// The image cut into tiles, rendered in parallel, pass after pass, into a [`RawFilm`].
 struct Tiles<'a> {
     width: u32,
     height: u32,
     cancel: &'a AtomicBool,
     progress: &'a (dyn Fn(usize, usize) + Sync),
     passes: usize,
+    checkpoint: Option<(Duration, &'a mut dyn FnMut(&RawFilm))>,
 }
 
 impl Tiles<'_> {
-    /// Computes `pixel(x, y, counts)` for every pixel, tiles in parallel; returns the values
-    /// row by row and whether every tile was done (tiles skipped after a cancel keep
-    /// `T::default()`).
-    fn run<T: Clone + Default + Send>(
-        &self,
+    /// Runs `pixel(x, y, sums, counts)` on every pixel of `film` that has not finished pass
+    /// `pass`, tiles in parallel, and marks it finished; whether every tile was done (those
+    /// skipped after a cancel keep their sums). When a checkpoint is due, the tiles in flight
+    /// finish, no new one starts, the film (with `splats`, the render's) is handed to the
+    /// checkpoint, and the rest follow.
+    fn run(
+        &mut self,
         pass: usize,
+        film: &mut RawFilm,
+        splats: &SplatBuffer,
         counts: &mut RayCounts,
-        pixel: impl Fn(u32, u32, &mut RayCounts) -> T + Sync,
-    ) -> (Vec<T>, bool) {
+        pixel: impl Fn(u32, u32, &mut PixelSums, &mut RayCounts) + Sync,
+    ) -> bool {
         let (w, h) = (self.width, self.height);
+        let stage = pass as u8 + 1;
         let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE_SIZE))
             .flat_map(|ty| {
                 (0..w.div_ceil(TILE_SIZE)).map(move |tx| (tx * TILE_SIZE, ty * TILE_SIZE))
             })
             .collect();
-        let total = tiles.len() * self.passes;
-        let done = std::sync::atomic::AtomicUsize::new(tiles.len() * pass);
-        let values = Mutex::new(vec![T::default(); w as usize * h as usize]);
-        let all_counts = Mutex::new(RayCounts::default());
-        let complete = AtomicBool::new(true);
-        tiles.par_iter().for_each(|&(x0, y0)| {
-            if self.cancel.load(Ordering::Relaxed) {
-                complete.store(false, Ordering::Relaxed);
-                return;
-            }
+        let bounds = |(x0, y0): (u32, u32)| {
             let (x1, y1) = ((x0 + TILE_SIZE).min(w), (y0 + TILE_SIZE).min(h));
-            let mut tile_counts = RayCounts::default();
-            let mut tile = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    tile.push((x, y, pixel(x, y, &mut tile_counts)));
-                }
+            (y0..y1).flat_map(move |y| (x0..x1).map(move |x| (x, y)))
+        };
+        let total = tiles.len() * self.passes;
+        loop {
+            let pending: Vec<(u32, u32)> = tiles
+                .iter()
+                .copied()
+                .filter(|&t| bounds(t).any(|(x, y)| film.stages[(y * w + x) as usize] < stage))
+                .collect();
+            if pending.is_empty() {
+                return true;
             }
+            let deadline = self
+                .checkpoint
+                .as_ref()
+                .map(|(every, _)| Instant::now() + *every);
+            let paused = AtomicBool::new(false);
+            let round = std::sync::atomic::AtomicUsize::new(0);
+            let done = std::sync::atomic::AtomicUsize::new(
+                tiles.len() * pass + tiles.len() - pending.len(),
+            );
+            let all_counts = Mutex::new(RayCounts::default());
             {
-                let mut values = values.lock().unwrap_or_else(|e| e.into_inner());
-                for (x, y, v) in tile {
-                    values[(y * w + x) as usize] = v;
+                let shared = Mutex::new(&mut *film);
+                pending.par_iter().for_each(|&tile| {
+                    if self.cancel.load(Ordering::Relaxed) {
+                        return;
+                    }
+                    // A checkpoint is due: start no more tiles, once one has been done
+                    // this round (however short the interval, the render goes on).
+                    if deadline.is_some_and(|d| Instant::now() >= d)
+                        && round.load(Ordering::Relaxed) > 0
+                    {
+                        paused.store(true, Ordering::Relaxed);
+                        return;
+                    }
+                    let mut sums: Vec<(u32, u32, PixelSums)> = {
+                        let f = shared.lock().unwrap_or_else(|e| e.into_inner());
+                        bounds(tile)
+                            .map(|(x, y)| (x, y, f.pixels[(y * w + x) as usize]))
+                            .collect()
+                    };
+                    let mut tile_counts = RayCounts::default();
+                    for (x, y, s) in &mut sums {
+                        pixel(*x, *y, s, &mut tile_counts);
+                    }
+                    {
+                        let mut f = shared.lock().unwrap_or_else(|e| e.into_inner());
+                        for (x, y, s) in sums {
+                            let i = (y * w + x) as usize;
+                            f.pixels[i] = s;
+                            f.stages[i] = stage;
+                        }
+                    }
+                    all_counts
+                        .lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .add(&tile_counts);
+                    round.fetch_add(1, Ordering::Relaxed);
+                    (self.progress)(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+                });
+            }
+            counts.add(&all_counts.into_inner().unwrap_or_else(|e| e.into_inner()));
+            if self.cancel.load(Ordering::Relaxed) {
+                return false;
+            }
+            if paused.load(Ordering::Relaxed) {
+                if let Some((_, save)) = self.checkpoint.as_mut() {
+                    if !film.splats.is_empty() {
+                        film.splats = splats.sums();
+                    }
+                    save(film);
                 }
             }
-            all_counts
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .add(&tile_counts);
-            (self.progress)(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-        });
-        counts.add(&all_counts.into_inner().unwrap_or_else(|e| e.into_inner()));
-        (
-            values.into_inner().unwrap_or_else(|e| e.into_inner()),
-            complete.load(Ordering::Relaxed),
-        )
-    }
-}
-
-/// Each pixel of a corner grid's image: the mean of its four corners.
-fn average_corners(corners: &Film) -> Film {
-    let (w, h) = (corners.width - 1, corners.height - 1);
-    let mut film = Film::new(w, h);
-    for y in 0..h {
-        for x in 0..w {
-            let sum = corners.get(x, y)
-                + corners.get(x + 1, y)
-                + corners.get(x, y + 1)
-                + corners.get(x + 1, y + 1);
-            film.set(x, y, sum * 0.25);
         }
     }
-    film
 }
 
 /// The average radiance of one pixel's samples (a box filter).
@@ -382,7 +479,7 @@ fn render_pixel(
             tree,
         ),
         Some(Adaptive::Variance { min_spp, .. }) => {
-            let mut e = PixelEstimate::default();
+            let mut e = PixelSums::default();
             let first = 0..min_spp;
             sample_pixel(
                 integrator,
@@ -398,7 +495,7 @@ fn render_pixel(
             e.value()
         }
         None => {
-            let mut e = PixelEstimate::default();
+            let mut e = PixelSums::default();
             let all = 0..settings.sampler.samples_per_pixel();
             sample_pixel(
                 integrator,
@@ -424,7 +521,7 @@ fn sample_pixel(
     settings: &RenderSettings,
     (x, y): (u32, u32),
     indices: std::ops::Range<u32>,
-    estimate: &mut PixelEstimate,
+    estimate: &mut PixelSums,
     counts: &mut RayCounts,
     mut tree: Option<&mut RayTree>,
 ) {
@@ -451,7 +548,7 @@ fn refine_pixel(
     camera: &Camera,
     settings: &RenderSettings,
     pixel: (u32, u32),
-    estimate: &mut PixelEstimate,
+    estimate: &mut PixelSums,
     counts: &mut RayCounts,
     mut tree: Option<&mut RayTree>,
 ) {
@@ -484,50 +581,6 @@ fn refine_pixel(
         if estimate.converged(threshold) {
             return;
         }
-    }
-}
-
-/// A pixel's running filter-weighted sum, and its luminance statistics for adaptive
-/// sampling.
-#[derive(Clone, Default)]
-struct PixelEstimate {
-    weighted: Color,
-    weight: f64,
-    plain: Color,
-    count: u32,
-    luminance: f64,
-    luminance_squared: f64,
-}
-
-impl PixelEstimate {
-    fn add(&mut self, c: Color, weight: f64) {
-        self.weighted += c * weight;
-        self.weight += weight;
-        self.plain += c;
-        self.count += 1;
-        let y = c.luminance();
-        self.luminance += y;
-        self.luminance_squared += y * y;
-    }
-
-    /// Σ w·L / Σ w; should the weights of a filter with negative lobes cancel out (a few
-    /// samples, all unlucky), the plain mean instead of a division by nearly zero.
-    fn value(&self) -> Color {
-        if self.weight > 0.25 * self.count as f64 {
-            self.weighted / self.weight
-        } else {
-            self.plain / self.count.max(1) as f64
-        }
-    }
-
-    fn converged(&self, threshold: f64) -> bool {
-        let n = self.count as f64;
-        if self.count < 2 {
-            return false;
-        }
-        let mean = self.luminance / n;
-        let variance = ((self.luminance_squared - n * mean * mean) / (n - 1.0)).max(0.0);
-        (variance / n).sqrt() <= threshold * mean.max(0.05)
     }
 }
 

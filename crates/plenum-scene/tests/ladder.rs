@@ -4,8 +4,11 @@
 //! smooth-shaded geometry, and against themselves for any thread count.
 
 use plenum_core::integrator::{ColorMode, IntegratorKind};
-use plenum_core::render::{render, RenderSettings};
-use std::sync::atomic::AtomicBool;
+use plenum_core::raw_film::RawFilm;
+use plenum_core::render::{new_film, render, render_film, Adaptive, RenderControl, RenderSettings};
+use plenum_core::sampling::{Filter, FilterKind};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
 
 mod common;
 use common::integrators::*;
@@ -423,6 +426,150 @@ fn splatting_integrators_honour_the_pixel_filter() {
                 assert!(
                     rate < 0.995 || ratio > 1.33,
                     "the filters cannot be told apart"
+                );
+            }
+        }
+    }
+}
+
+/// Renders into `film`, handing a copy of it to `saved` at every checkpoint (after each
+/// round of tiles, the interval being zero) and cancelling once `stop_after` tiles are done.
+fn render_stopping(
+    l: &plenum_scene::LoadedScene,
+    settings: &RenderSettings,
+    film: &mut RawFilm,
+    saved: Option<&mut Vec<RawFilm>>,
+    stop_after: Option<usize>,
+) -> Vec<[f32; 3]> {
+    let cancel = AtomicBool::new(false);
+    let progress = |done: usize, _: usize| {
+        if stop_after.is_some_and(|n| done >= n) {
+            cancel.store(true, Ordering::SeqCst);
+        }
+    };
+    let checkpointing = saved.is_some();
+    let mut saved = saved;
+    let mut keep = |f: &RawFilm| {
+        if let Some(s) = saved.as_deref_mut() {
+            s.push(f.clone());
+        }
+    };
+    let checkpoint: Option<(Duration, &mut dyn FnMut(&RawFilm))> = if checkpointing {
+        Some((Duration::ZERO, &mut keep))
+    } else {
+        None
+    };
+    let control = RenderControl {
+        cancel: &cancel,
+        progress: &progress,
+        checkpoint,
+    };
+    render_film(&l.scene, settings, film, control)
+        .film
+        .pixels()
+        .to_vec()
+}
+
+/// Every method but SPPM sums its pixels in fixed point: a render stopped at any checkpoint
+/// or cancelled mid-way and continued from its film, or split into sample ranges rendered
+/// apart and merged, gives the same bytes as one render. With the box filter and with
+/// Mitchell's (negative lobes, splats spread over several pixels), in both colour modes;
+/// adaptive sampling (Whitted's subdivision, and by variance over its two passes) resumes
+/// to the same bytes too.
+#[test]
+fn every_method_resumes_and_merges_to_the_same_bytes() {
+    let l = plenum_scene::load_scene(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/ladder.toml"),
+    )
+    .unwrap();
+    let mut cases = Vec::new();
+    for (i, kind) in IntegratorKind::ALL.into_iter().enumerate() {
+        if kind == IntegratorKind::Sppm {
+            continue;
+        }
+        let color = if i % 2 == 0 {
+            ColorMode::Rgb
+        } else {
+            ColorMode::Spectral
+        };
+        let mut s = settings_for(&l, kind, 4, color, 5);
+        (s.width, s.height) = (40, 34);
+        s.integrator.photon.photons = 3000;
+        s.integrator.photon.caustic_photons = 3000;
+        cases.push(s.clone());
+        if kind.splats() || kind == IntegratorKind::Path {
+            s.filter = Filter::new(FilterKind::Mitchell, 2.0).unwrap();
+            cases.push(s);
+        }
+    }
+    for s in &cases {
+        let name = format!(
+            "{} {:?} {:?}",
+            s.integrator.kind.name(),
+            s.integrator.color,
+            s.filter
+        );
+        let whole = draw(&l, s);
+        let spp = s.sampler.samples_per_pixel();
+        // Every checkpoint, continued.
+        let mut saved = Vec::new();
+        let mut film = new_film(s, 0..spp);
+        let image = render_stopping(&l, s, &mut film, Some(&mut saved), None);
+        assert!(image == whole, "{name}: a render that checkpoints");
+        assert!(saved.len() >= 3, "{name}: {} checkpoints", saved.len());
+        for (i, f) in saved.iter().enumerate().step_by(2) {
+            let mut f = f.clone();
+            let image = render_stopping(&l, s, &mut f, None, None);
+            assert!(image == whole, "{name}: continued from checkpoint {i}");
+        }
+        // Cancelled after three tiles, then continued.
+        let mut film = new_film(s, 0..spp);
+        render_stopping(&l, s, &mut film, None, Some(3));
+        assert!(!film.is_complete(1), "{name}: the cancel stopped it");
+        let image = render_stopping(&l, s, &mut film, None, None);
+        assert!(image == whole, "{name}: continued after a cancel");
+        // Sample ranges, merged in any order.
+        let parts: Vec<RawFilm> = [2..4, 0..1, 1..2]
+            .into_iter()
+            .map(|r| {
+                let mut f = new_film(s, r);
+                render_stopping(&l, s, &mut f, None, None);
+                f
+            })
+            .collect();
+        let merged = RawFilm::merge(parts).unwrap();
+        assert!(
+            merged.image().pixels() == &whole[..],
+            "{name}: merged ranges"
+        );
+    }
+    // Adaptive sampling resumes (it cannot be split into sample ranges).
+    for adaptive in [
+        Adaptive::Subdivide {
+            contrast: 0.05,
+            depth: 2,
+        },
+        Adaptive::Variance {
+            threshold: 0.05,
+            min_spp: 4,
+            max_spp: 16,
+        },
+    ] {
+        for kind in [IntegratorKind::Whitted, IntegratorKind::Path] {
+            let mut s = settings_for(&l, kind, 4, ColorMode::Rgb, 5);
+            (s.width, s.height) = (40, 34);
+            s.adaptive = Some(adaptive);
+            let whole = draw(&l, &s);
+            let mut saved = Vec::new();
+            let mut film = new_film(&s, 0..4);
+            render_stopping(&l, &s, &mut film, Some(&mut saved), None);
+            for (i, f) in saved.iter().enumerate() {
+                let mut f = f.clone();
+                let image = render_stopping(&l, &s, &mut f, None, None);
+                assert!(
+                    image == whole,
+                    "{adaptive:?} {}: checkpoint {i}",
+                    kind.name()
                 );
             }
         }
