@@ -18,6 +18,7 @@ use common::integrators::*;
 /// mean within ±0.01 (seed 3; light tracing's standard error is about 0.003 there, BDPT's
 /// less).
 #[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
 fn light_tracing_and_bdpt_converge_in_the_furnace() {
     let cases = furnace_cases();
     for kind in [IntegratorKind::Light, IntegratorKind::Bdpt] {
@@ -91,6 +92,7 @@ fn every_method_cuts_paths_at_the_same_depth() {
 /// `cook16`, whose fixed pairing of regions, the same in every pixel, tied its light paths'
 /// choices together across the image (0.87 for 1).
 #[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
 fn every_method_converges_with_every_sampler() {
     use plenum_core::sampling::{PixelSampler, SamplerKind};
     let (_, _, emission) = &furnace_cases()[2];
@@ -130,6 +132,7 @@ fn every_method_converges_with_every_sampler() {
 }
 
 #[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
 fn light_tracing_matches_mitsuba_on_the_cornell_box() {
     cbox_z_test(
         IntegratorKind::Light,
@@ -140,6 +143,7 @@ fn light_tracing_matches_mitsuba_on_the_cornell_box() {
 }
 
 #[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
 fn bdpt_matches_mitsuba_on_the_cornell_box() {
     cbox_z_test(
         IntegratorKind::Bdpt,
@@ -365,6 +369,7 @@ fn light_paths_find_the_lens_of_a_moving_thin_lens_camera() {
 /// open in docs/integrators.md. Against the path tracer's box-filtered image the
 /// Mitchell-filtered light-traced one fails (the test can tell the filters apart).
 #[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
 fn splatting_integrators_honour_the_pixel_filter() {
     use plenum_core::sampling::{Filter, FilterKind};
     let l = load_cornell_box();

@@ -150,6 +150,7 @@ fn worst_block_error(image: &[[f32; 3]], reference: &[[f32; 3]], width: usize) -
 /// off, in the corners, where density estimation blurs light across the edge). The test
 /// allows ±1.5 % on each channel's mean.
 #[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
 fn photon_mapping_cornell_box_mean_matches_mitsuba() {
     let l = load_cornell_box();
     for (color, file) in [
@@ -204,11 +205,13 @@ fn sppm_furnaces(color: ColorMode) {
 }
 
 #[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
 fn sppm_furnaces_converge_to_radiance_one_in_rgb() {
     sppm_furnaces(ColorMode::Rgb);
 }
 
 #[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
 fn sppm_furnaces_converge_to_radiance_one_spectrally() {
     sppm_furnaces(ColorMode::Spectral);
 }
@@ -255,11 +258,13 @@ fn sppm_z_test(color: ColorMode, reference: &str, variance: &str) {
 }
 
 #[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
 fn sppm_matches_mitsuba_on_the_cornell_box_in_rgb() {
     sppm_z_test(ColorMode::Rgb, "reference.exr", "reference-variance.exr");
 }
 
 #[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
 fn sppm_matches_mitsuba_on_the_cornell_box_spectrally() {
     sppm_z_test(
         ColorMode::Spectral,

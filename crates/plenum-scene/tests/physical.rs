@@ -112,6 +112,7 @@ faces = [[0, 2, 1], [3, 4, 5], [0, 1, 4, 3], [1, 2, 5, 4], [2, 0, 3, 5]]
 }
 
 #[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
 fn cornell_box_matches_mitsuba_in_rgb() {
     cbox_z_test(
         IntegratorKind::Path,
@@ -122,6 +123,7 @@ fn cornell_box_matches_mitsuba_in_rgb() {
 }
 
 #[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
 fn cornell_box_matches_mitsuba_spectrally() {
     cbox_z_test(
         IntegratorKind::Path,
