@@ -14,7 +14,7 @@
 
 use crate::camera::Camera;
 use crate::color::Color;
-use crate::film::SplatBuffer;
+use crate::film::{Film, SplatBuffer};
 use crate::integrator::{
     Integrator, IntegratorConfig, IntegratorKind, RayCounts, RayTree, StrategyImages,
 };
@@ -123,13 +123,13 @@ pub const TILE_SIZE: u32 = 16;
 
 #[derive(Clone, Debug)]
 pub struct RenderOutput {
-    pub film: crate::film::Film,
+    pub film: Film,
     pub counts: RayCounts,
     /// False when the render was cancelled: tiles not yet rendered are black.
     pub complete: bool,
     /// Bidirectional path tracing with `strategies` set: for each strategy (s, t), its
     /// image weighted by MIS and unweighted.
-    pub strategies: Vec<(usize, usize, crate::film::Film, crate::film::Film)>,
+    pub strategies: Vec<(usize, usize, Film, Film)>,
 }
 
 /// What the caller of [`render_film`] may do while it runs.
@@ -190,6 +190,10 @@ pub fn render_film(
     film: &mut RawFilm,
     mut control: RenderControl,
 ) -> RenderOutput {
+    debug_assert!(
+        settings.integrator.kind != IntegratorKind::Sppm,
+        "SPPM renders by `render`, iteration by iteration"
+    );
     // Splats are pixel values once divided by the light paths per pixel; the camera's
     // importance reaches as far beyond the image as the filter spreads them.
     let spp = settings.sampler.samples_per_pixel().max(1);
@@ -317,7 +321,7 @@ pub fn render_film(
     counts.invalid += splats.clamped();
     let strategies = strategies.map_or_else(Vec::new, |si| {
         let film_of = |b: &SplatBuffer| {
-            let mut f = crate::film::Film::new(settings.width, settings.height);
+            let mut f = Film::new(settings.width, settings.height);
             f.add_splats(b);
             f.resolve(1.0);
             f

@@ -392,3 +392,83 @@ position = [2, 3, 4]
         }
     }
 }
+
+/// A one-sided emitter's light leaves the side that a ray hitting it sees as its front:
+/// a concave polygon under a mirroring transform, a polyhedron mirrored, and a mesh whose
+/// vertex normals oppose its winding. Each point the light samples, approached along the
+/// normal it was sampled with, is hit on the face whose normal is that one; and the
+/// concave polygon's sampled points all lie on it (its emitter's area is its own, 3).
+#[test]
+fn one_sided_emitters_agree_on_their_side() {
+    use plenum_core::light::Light;
+    use plenum_core::math::Ray;
+    let l = plenum_scene::parse_scene(
+        std::path::Path::new("sides.toml"),
+        r#"
+[camera]
+position = [0, 0, 10]
+look_at = [0, 0, 0]
+
+[[objects]]
+type = "polygon"
+vertices = [[2, 1, 0], [1, 1, 0], [1, 2, 0], [0, 2, 0], [0, 0, 0], [2, 0, 0]]
+emission = [1, 1, 1]
+two_sided = false
+transform = [{ scale = [-1, 1, 1] }, { rotate = { axis = [1, 1, 0], degrees = 30 } }]
+
+[[objects]]
+type = "polyhedron"
+vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]
+faces = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]
+emission = [1, 1, 1]
+two_sided = false
+transform = [{ scale = [1, -1, 1] }, { translate = [4, 0, 0] }]
+
+[[objects]]
+type = "mesh"
+positions = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]
+indices = [[0, 1, 2]]
+normals = [[0, 0, -1], [0, 0, -1], [0, 0, -1]]
+emission = [1, 1, 1]
+two_sided = false
+transform = [{ translate = [-4, 0, 0] }]
+"#,
+        std::path::Path::new("."),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let s = &l.scene;
+    let mut checked = 0;
+    for (i, light) in s.lights.iter().enumerate() {
+        let Light::Area {
+            shape, two_sided, ..
+        } = light
+        else {
+            continue;
+        };
+        assert!(!two_sided);
+        if i == 0 {
+            assert!(
+                (shape.area() - 3.0).abs() < 1e-9,
+                "L-shaped polygon area {}",
+                shape.area()
+            );
+        }
+        for j in 0..64 {
+            let u = [(j % 8) as f64 / 8.0 + 0.0625, (j / 8) as f64 / 8.0 + 0.0625];
+            let (p, n) = shape.sample_area(u).unwrap();
+            let ray = Ray::new(p + n * 0.01, -n);
+            let (prim, hit) = s
+                .intersect(&ray, 0.02)
+                .unwrap_or_else(|| panic!("light {i}: sampled point {p:?} is not on the surface"));
+            assert_eq!(s.light_of(prim), Some(i as u32), "light {i}");
+            let it = s.interaction(&ray, prim, &hit);
+            assert!(
+                it.n.dot(n) > 0.999,
+                "light {i}: sampled normal {n:?}, hit normal {:?}",
+                it.n
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 3 * 64);
+}

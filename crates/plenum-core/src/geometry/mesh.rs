@@ -388,6 +388,26 @@ impl TriangleMesh {
             .map(|(part, _)| (part, self.triangle(part)))
     }
 
+    /// Each triangle once, wound so that its corners' cross product points the way a hit
+    /// on it reports its normal: by the winding, or where the mesh has vertex normals, to
+    /// their side (as [`TriangleMesh::surface`] turns it). What an emitter samples.
+    pub fn outward_triangles(&self) -> impl Iterator<Item = [Vec3; 3]> + '_ {
+        self.triangles().map(|(part, [p0, p1, p2])| {
+            let normals = self
+                .vertex_indices(part)
+                .filter(|_| !self.normals.is_empty());
+            let shading = normals.map_or(Vec3::ZERO, |idx| {
+                idx.iter()
+                    .fold(Vec3::ZERO, |a, &i| a + self.normals[i as usize])
+            });
+            if (p1 - p0).cross(p2 - p0).dot(shading) < 0.0 {
+                [p0, p2, p1]
+            } else {
+                [p0, p1, p2]
+            }
+        })
+    }
+
     /// Every stored triangle (each copy, in a grid or an octree) with its position in the
     /// list the mesh was made from.
     fn stored_parts(&self) -> impl Iterator<Item = (u32, u32)> + '_ {

@@ -146,6 +146,95 @@ impl Polygon {
     }
 }
 
+impl Polygon {
+    /// The polygon's area as triangles wound counter-clockwise about its normal, covering
+    /// exactly what the even–odd test calls inside, for concave and self-crossing loops
+    /// alike (a fan from one vertex covers a concave polygon's notch). In the projection,
+    /// the plane is cut into slabs at every vertex and every crossing of two edges; within
+    /// a slab no two edges cross, so sorted by x the edges pair off, inside between the
+    /// first and second, the third and fourth, …, each pair a trapezoid of two triangles.
+    pub fn triangles(&self) -> Vec<[Vec3; 3]> {
+        type Edge = ([f64; 2], [f64; 2]);
+        let n = self.projected.len();
+        let edges: Vec<Edge> = (0..n)
+            .map(|i| (self.projected[i], self.projected[(i + 1) % n]))
+            .filter(|(a, b)| a[1] != b[1])
+            .collect();
+        let mut ys: Vec<f64> = self.projected.iter().map(|p| p[1]).collect();
+        for (i, e) in edges.iter().enumerate() {
+            for f in &edges[i + 1..] {
+                ys.extend(crossing_y(*e, *f));
+            }
+        }
+        ys.sort_by(f64::total_cmp);
+        ys.dedup();
+        let x_at = |(a, b): Edge, y: f64| a[0] + (y - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
+        // Back from the projection onto the plane: normal·p = dist.
+        let (a, b) = self.axes;
+        let c = 3 - a - b;
+        let lift = |[u, v]: [f64; 2]| {
+            let mut p = [0.0; 3];
+            p[a] = u;
+            p[b] = v;
+            p[c] = (self.dist - self.normal[a] * u - self.normal[b] * v) / self.normal[c];
+            Vec3::new(p[0], p[1], p[2])
+        };
+        let size = Bounds3::from_points(self.projected.iter().map(|p| Vec3::new(p[0], p[1], 0.0)))
+            .diagonal()
+            .length();
+        let tiny = 1e-12 * size * size;
+        let mut triangles = Vec::new();
+        for w in ys.windows(2) {
+            let (y0, y1) = (w[0], w[1]);
+            let middle = 0.5 * (y0 + y1);
+            // The edges crossing the slab, by the same rule as `contains`.
+            let mut crossing: Vec<Edge> = edges
+                .iter()
+                .copied()
+                .filter(|(p, q)| (p[1] > middle) != (q[1] > middle))
+                .collect();
+            crossing.sort_by(|e, f| x_at(*e, middle).total_cmp(&x_at(*f, middle)));
+            for pair in crossing.chunks_exact(2) {
+                let (l, r) = (pair[0], pair[1]);
+                let q = [
+                    [x_at(l, y0), y0],
+                    [x_at(r, y0), y0],
+                    [x_at(r, y1), y1],
+                    [x_at(l, y1), y1],
+                ];
+                for t in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
+                    let twice_area = (t[1][0] - t[0][0]) * (t[2][1] - t[0][1])
+                        - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]);
+                    // Slivers of rounding where two edges meet add nothing.
+                    if !(twice_area.abs() > tiny) {
+                        continue;
+                    }
+                    let [p, q, r] = t.map(lift);
+                    triangles.push(if (q - p).cross(r - p).dot(self.normal) >= 0.0 {
+                        [p, q, r]
+                    } else {
+                        [p, r, q]
+                    });
+                }
+            }
+        }
+        triangles
+    }
+}
+
+/// The height at which two edges cross inside both, if they do (not at a shared end).
+fn crossing_y((p, p2): ([f64; 2], [f64; 2]), (q, q2): ([f64; 2], [f64; 2])) -> Option<f64> {
+    let (r, s) = ([p2[0] - p[0], p2[1] - p[1]], [q2[0] - q[0], q2[1] - q[1]]);
+    let denominator = r[0] * s[1] - r[1] * s[0];
+    if denominator == 0.0 {
+        return None;
+    }
+    let d = [q[0] - p[0], q[1] - p[1]];
+    let t = (d[0] * s[1] - d[1] * s[0]) / denominator;
+    let u = (d[0] * r[1] - d[1] * r[0]) / denominator;
+    (t > 0.0 && t < 1.0 && u > 0.0 && u < 1.0).then(|| p[1] + t * r[1])
+}
+
 /// Newell's method: a vector normal to the polygon whose length is twice its area, robust
 /// for concave and slightly non-planar loops.
 pub(crate) fn newell_normal(vertices: &[Vec3]) -> Vec3 {
@@ -191,6 +280,95 @@ mod tests {
         assert!(poly.intersect(&down(2.5, 0.5), 1e9).is_none());
         let hit = poly.intersect(&down(0.5, 0.5), 1e9).unwrap();
         assert!((hit.t - 4.0).abs() < 1e-15);
+    }
+
+    fn area(triangles: &[[Vec3; 3]]) -> f64 {
+        triangles
+            .iter()
+            .map(|[p, q, r]| 0.5 * (*q - *p).cross(*r - *p).length())
+            .sum()
+    }
+
+    /// The area the even–odd test calls inside, by counting a fine grid of points of the
+    /// plane (a independent of the triangles), and whether every triangle lies inside.
+    fn check_triangles(poly: &Polygon, grid: usize) {
+        let triangles = poly.triangles();
+        for t in &triangles {
+            assert!(
+                (t[1] - t[0]).cross(t[2] - t[0]).dot(poly.normal()) > 0.0,
+                "wound about the normal"
+            );
+            let centroid = (t[0] + t[1] + t[2]) / 3.0;
+            assert!(poly.contains(centroid), "{t:?} lies outside");
+        }
+        let b = poly.bounds();
+        let (lo, hi) = (b.min, b.max);
+        let (a0, a1) = poly.axes;
+        let (w, h) = (hi[a0] - lo[a0], hi[a1] - lo[a1]);
+        let mut inside = 0;
+        for i in 0..grid {
+            for j in 0..grid {
+                let mut p = lo;
+                let u = lo[a0] + (i as f64 + 0.5) / grid as f64 * w;
+                let v = lo[a1] + (j as f64 + 0.5) / grid as f64 * h;
+                p = match (a0, a1) {
+                    (0, 1) => Vec3::new(u, v, p.z),
+                    (1, 2) => Vec3::new(p.x, u, v),
+                    _ => Vec3::new(v, p.y, u),
+                };
+                inside += usize::from(poly.contains(p));
+            }
+        }
+        let counted = inside as f64 / (grid * grid) as f64 * w * h;
+        // In projection: the triangles' projected area.
+        let n = poly.normal();
+        let projected = area(&triangles) * n[3 - a0 - a1].abs();
+        assert!(
+            (projected - counted).abs() < 4.0 * (w + h) / grid as f64 * (w.max(h)),
+            "{projected} against {counted}"
+        );
+    }
+
+    /// A fan from the first vertex of the L covers its notch (area 4); the triangles cover
+    /// the L (area 3) and nothing else.
+    #[test]
+    fn triangles_cover_concave_and_self_crossing_polygons() {
+        let l = l_shape();
+        assert!((area(&l.triangles()) - 3.0).abs() < 1e-12);
+        let l_from_notch = Polygon::new(vec![
+            Vec3::new(2.0, 1.0, 1.0),
+            Vec3::new(1.0, 1.0, 1.0),
+            Vec3::new(1.0, 2.0, 1.0),
+            Vec3::new(0.0, 2.0, 1.0),
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(2.0, 0.0, 1.0),
+        ])
+        .unwrap();
+        assert!((area(&l_from_notch.triangles()) - 3.0).abs() < 1e-12);
+        check_triangles(&l_from_notch, 400);
+        // A ten-pointed star, tilted out of every coordinate plane.
+        let tilt = |x: f64, y: f64| Vec3::new(x, y * 0.8, 0.3 * x + y * 0.6);
+        let star: Vec<Vec3> = (0..10)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::PI / 5.0;
+                let r = if i % 2 == 0 { 1.0 } else { 0.4 };
+                tilt(r * a.cos(), r * a.sin())
+            })
+            .collect();
+        check_triangles(&Polygon::new(star).unwrap(), 600);
+        // A pentagram drawn in one stroke: its middle is outside by the even–odd rule.
+        let pentagram: Vec<Vec3> = (0..5)
+            .map(|i| {
+                let a = (i * 2) as f64 * 2.0 * std::f64::consts::PI / 5.0;
+                Vec3::new(a.cos(), a.sin(), 0.0)
+            })
+            .collect();
+        let pentagram = Polygon::new(pentagram).unwrap();
+        check_triangles(&pentagram, 600);
+        assert!(!pentagram.contains(Vec3::ZERO));
+        // A convex face keeps its area.
+        let square = Polygon::new(vec![Vec3::ZERO, Vec3::X, Vec3::X + Vec3::Y, Vec3::Y]).unwrap();
+        assert!((area(&square.triangles()) - 1.0).abs() < 1e-12);
     }
 
     #[test]

@@ -128,10 +128,11 @@ pub(super) fn bsdf_pdf(bsdf: &Bsdf, wo: Vec3, bs: &crate::bxdf::BsdfSample) -> f
     }
 }
 
-/// One BSDF-sampled ray's part of direct light at `it` toward `wo`, for a method whose path
-/// does not go on from `it` (SPPM's visible point): the emitter or infinite light it finds,
-/// weighed against one light sample. A specular lobe's direction counts in full: light
-/// sampling cannot find it.
+/// One BSDF-sampled ray's part of direct light at `it` toward `wo`, for a path that does not
+/// go on from `it` (SPPM's visible point, the path tracer's last vertex): the emitter or
+/// infinite light it finds, weighed against one light sample, and in full what light
+/// sampling cannot find: the background, a Phong surface's k_e, and whatever a specular
+/// lobe's direction meets.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn bsdf_sample_ld(
     scene: &Scene,
@@ -163,11 +164,25 @@ pub(super) fn bsdf_sample_ld(
     };
     let ray = Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(time);
     let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
-        return beta * infinite_mis(scene, bs.wi, wl, pdf_bsdf, 1.0);
+        let d = bs.wi.normalized();
+        return beta * (scene.background_spectrum(wl) + infinite_mis(scene, d, wl, pdf_bsdf, 1.0));
     };
-    let Some(light) = scene.light_of(prim) else {
-        return SampledSpectrum::ZERO;
-    };
-    let hit_it = scene.interaction(&ray, prim, &hit);
-    beta * emitted_mis(scene, light, &hit_it, -bs.wi, wl, pdf_bsdf, it.p, 1.0)
+    match scene.light_of(prim) {
+        Some(light) => {
+            let hit_it = scene.interaction(&ray, prim, &hit);
+            beta * emitted_mis(scene, light, &hit_it, -bs.wi, wl, pdf_bsdf, it.p, 1.0)
+        }
+        // Only a surface with k_e gives light: the others need no interaction.
+        None if scene
+            .material_of(prim)
+            .phong()
+            .is_some_and(|m| !m.emissive.is_black()) =>
+        {
+            let hit_it = scene.interaction(&ray, prim, &hit);
+            scene
+                .phong_emission(&hit_it, wl)
+                .map_or(SampledSpectrum::ZERO, |ke| beta * ke)
+        }
+        None => SampledSpectrum::ZERO,
+    }
 }

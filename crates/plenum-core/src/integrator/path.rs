@@ -140,17 +140,25 @@ impl<'a> PathTracer<'a> {
             };
             let flags = bsdf.flags();
             if flags.is_non_specular() {
-                // The light sample is weighed against the next bounce's, which the last
-                // vertex does not take.
-                let n = if depth < self.max_depth { 1.0 } else { 0.0 };
-                let ld = direct::sample_ld(scene, &it, wo, &bsdf, wl, stream, counts, ray.time, n);
+                // Weighed against the BSDF-sampled ray, the next bounce's or, at the last
+                // vertex, one traced for its light alone.
+                let ld =
+                    direct::sample_ld(scene, &it, wo, &bsdf, wl, stream, counts, ray.time, 1.0);
                 l += beta * ld;
             }
-            record(&mut tree, node, |n| n.color = added(l, wl));
             if depth >= self.max_depth {
-                record(&mut tree, node, |n| n.stops.push(Stop::Depth));
+                // The last vertex still takes the light its BSDF-sampled ray meets (an
+                // emitter, the sky, light seen in a mirror), but the path ends here (as
+                // pbrt-v4's and Mitsuba's path tracers count depth).
+                l += beta
+                    * direct::bsdf_sample_ld(scene, &it, wo, &bsdf, wl, stream, counts, ray.time);
+                record(&mut tree, node, |n| {
+                    n.color = added(l, wl);
+                    n.stops.push(Stop::Depth);
+                });
                 break;
             }
+            record(&mut tree, node, |n| n.color = added(l, wl));
 
             let uc = stream.next_1d();
             let u = stream.next_2d();

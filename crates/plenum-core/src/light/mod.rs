@@ -137,13 +137,31 @@ pub enum Emitter {
 impl Emitter {
     /// The emitter that samples a placed shape's surface: a sphere (under a transform that
     /// keeps it round) or disk as itself, a mesh, polygon, box or polyhedron by its
-    /// triangles in world space (normals by their winding); `None` for shapes it cannot
+    /// triangles in world space (normals by their winding; a polygon's, concave or not, from
+    /// [`Polygon::triangles`](crate::geometry::Polygon::triangles)); `None` for shapes it cannot
     /// sample (planes, cylinders, cones) or without area.
     pub fn of_shape(shape: &Shape, to_world: &Transform) -> Option<Emitter> {
         let world = |p: Vec3| to_world.point(p);
+        // A transform that mirrors (negative determinant) reverses the winding of what it
+        // places, but not the normal a hit reports (the inverse transpose): wound back, the
+        // triangles' normals are the hit's, so one-sided light leaves the same side for
+        // light sampling, light paths and rays that meet it.
+        let mirrors = {
+            let [x, y, z] = [Vec3::X, Vec3::Y, Vec3::Z].map(|a| to_world.vector(a));
+            x.dot(y.cross(z)) < 0.0
+        };
+        let place = |[p, q, r]: [Vec3; 3]| {
+            if mirrors {
+                [world(p), world(r), world(q)]
+            } else {
+                [world(p), world(q), world(r)]
+            }
+        };
+        let on_world = |ts: Vec<[Vec3; 3]>| ts.into_iter().map(place).collect();
+        // The box's faces are convex: a fan covers each.
         let fan = |vs: &[Vec3]| -> Vec<[Vec3; 3]> {
             (1..vs.len().saturating_sub(1))
-                .map(|i| [world(vs[0]), world(vs[i]), world(vs[i + 1])])
+                .map(|i| place([vs[0], vs[i], vs[i + 1]]))
                 .collect()
         };
         match shape {
@@ -161,13 +179,12 @@ impl Emitter {
                 normal: d.normal.normalized(),
                 radius: d.radius,
             }),
-            Shape::Mesh(m) => {
-                Emitter::triangles(m.triangles().map(|(_, t)| t.map(world)).collect())
-            }
-            Shape::Polygon(p) => Emitter::triangles(fan(p.vertices())),
-            Shape::Polyhedron(p) => {
-                Emitter::triangles(p.faces().iter().flat_map(|f| fan(f.vertices())).collect())
-            }
+            Shape::Mesh(m) => Emitter::triangles(m.outward_triangles().map(place).collect()),
+            // Concave faces too: the polygon's own triangles, not a fan.
+            Shape::Polygon(p) => Emitter::triangles(on_world(p.triangles())),
+            Shape::Polyhedron(p) => Emitter::triangles(on_world(
+                p.faces().iter().flat_map(|f| f.triangles()).collect(),
+            )),
             Shape::Cuboid(c) => {
                 let (a, b) = (c.min, c.max);
                 let v = |x: bool, y: bool, z: bool| {
