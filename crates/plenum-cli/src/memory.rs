@@ -6,15 +6,15 @@
 use plenum_core::integrator::IntegratorKind;
 
 /// Bytes per pixel a render allocates, by what it keeps per pixel, measured as peak resident
-/// memory over 1024² pixels (December 2026) and rounded up by a quarter: the raw film's
-/// exact sums (145 bytes) and the image resolved from it (68), splats in fixed point (light
-/// tracing, BDPT: the buffer, the film's copy and the copy made at a checkpoint), SPPM's
-/// visible points, adaptive sampling's open flags.
+/// memory over 1024² pixels (December 2026: 190 bytes for Whitted's method, 260 for BDPT)
+/// and rounded up by a quarter: the raw film's exact sums (145 bytes) and the image
+/// resolved from it, splats in fixed point (light tracing, BDPT: the buffer and the film's
+/// copy), SPPM's visible points, adaptive sampling's open flags.
 pub fn bytes_per_pixel(kind: IntegratorKind, adaptive: bool, strategy_images: usize) -> u64 {
     let base = match kind {
         IntegratorKind::Sppm => 610,
-        IntegratorKind::Light | IntegratorKind::Bdpt => 290,
-        _ => 215,
+        IntegratorKind::Light | IntegratorKind::Bdpt => 260,
+        _ => 190,
     };
     let adaptive = if adaptive { 2 } else { 0 };
     // BDPT's strategy images: two films each (weighted and unweighted).
@@ -118,7 +118,7 @@ mod tests {
     fn a_film_larger_than_what_is_available_is_refused() {
         let per_pixel = bytes_per_pixel(IntegratorKind::Whitted, false, 0);
         let four_gb = Some((4u64 << 30, "a test"));
-        // 16384² pixels, the largest size accepted, need some 67 GiB.
+        // 16384² pixels, the largest size accepted, need some 59 GiB.
         let e = check(16384, 16384, per_pixel, four_gb).unwrap_err();
         assert!(e.contains("16384×16384") && e.contains("4.00 GiB"), "{e}");
         assert!(check(3072, 3072, per_pixel, four_gb).is_ok());
