@@ -564,6 +564,14 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
         .map(|a| a.0)
         .or(d.integrator)
         .unwrap_or_else(|| loaded.scene.default_integrator());
+    let ignored = options_ignored_by(view, method);
+    if !ignored.is_empty() {
+        eprintln!(
+            "warning: integrator `{}` does not read {}: ignored",
+            method.name(),
+            ignored.join(", ")
+        );
+    }
     let color = view.color.map(|a| a.0).or(d.color).unwrap_or_default();
     let light_sampler = view.light_sampler.map_or(d.light_sampler, |a| a.0);
     loaded.scene.set_light_sampler(light_sampler);
@@ -607,6 +615,61 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
         return Err(ExitCode::from(2));
     }
     Ok(settings)
+}
+
+/// The options given on the command line that `method` does not read: each integrator
+/// reads its own (photon counts only photon mapping, SPPM's only SPPM; Russian roulette,
+/// light selection and wavelengths only the physically based methods; depth not local
+/// illumination or Appel's method, which do not recurse).
+fn options_ignored_by(view: &ViewArgs, method: IntegratorKind) -> Vec<&'static str> {
+    use IntegratorKind::{Appel, Local, Photon, Sppm};
+    let classic = method.is_classic();
+    let given = [
+        (view.photons.is_some(), "--photons", method != Photon),
+        (
+            view.caustic_photons.is_some(),
+            "--caustic-photons",
+            method != Photon,
+        ),
+        (
+            view.photon_nearest.is_some(),
+            "--photon-nearest",
+            method != Photon,
+        ),
+        (
+            view.gather_rays.is_some(),
+            "--gather-rays",
+            method != Photon,
+        ),
+        (
+            view.photon_radius.is_some(),
+            "--photon-radius",
+            !matches!(method, Photon | Sppm),
+        ),
+        (
+            view.sppm_photons.is_some(),
+            "--sppm-photons",
+            method != Sppm,
+        ),
+        (view.sppm_alpha.is_some(), "--sppm-alpha", method != Sppm),
+        (view.rr_depth.is_some(), "--rr-depth", classic),
+        (view.light_sampler.is_some(), "--light-sampler", classic),
+        (
+            view.color == Some(ColorArg(ColorMode::Spectral)),
+            "--color spectral (Whitted's model is RGB)",
+            classic,
+        ),
+        (
+            view.max_depth.is_some(),
+            "--max-depth",
+            matches!(method, Local | Appel),
+        ),
+    ];
+    given
+        .into_iter()
+        .filter(|&(given, _, ignored)| given && ignored)
+        .map(|(_, name, _)| name)
+        .collect()
 }
 
 /// Rays by kind, the kinds the method traced (camera, shadow, reflection and refraction

@@ -740,6 +740,63 @@ fn a_newcomers_mistakes_get_clear_answers() {
     );
     assert!(!e.contains("--sppm-alpha"), "{e}");
 
+    // Options the chosen method does not read are named, with the method.
+    for (args, says) in [
+        (
+            &[
+                "--integrator",
+                "path",
+                "--photons",
+                "1000",
+                "--sppm-alpha",
+                "0.5",
+            ][..],
+            "`path` does not read --photons, --sppm-alpha",
+        ),
+        (
+            &[
+                "--integrator",
+                "whitted",
+                "--rr-depth",
+                "3",
+                "--color",
+                "spectral",
+            ][..],
+            "`whitted` does not read --rr-depth, --color spectral",
+        ),
+        (
+            &["--integrator", "local", "--max-depth", "3"][..],
+            "`local` does not read --max-depth",
+        ),
+        (
+            &["--integrator", "sppm", "--gather-rays", "4", "--spp", "2"][..],
+            "`sppm` does not read --gather-rays",
+        ),
+    ] {
+        let o = run(&[&["render"][..], args, &small].concat());
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(says), "{args:?}: {}", stderr(&o));
+    }
+    for args in [
+        &[
+            "--integrator",
+            "photon",
+            "--photons",
+            "1000",
+            "--photon-radius",
+            "0.5",
+        ][..],
+        &["--integrator", "sppm", "--sppm-alpha", "0.5", "--spp", "2"][..],
+        &["--integrator", "appel", "--color", "rgb"][..],
+    ] {
+        let o = run(&[&["render"][..], args, &small].concat());
+        assert!(
+            o.status.success() && !stderr(&o).contains("does not read"),
+            "{args:?}: {}",
+            stderr(&o)
+        );
+    }
+
     // A file that is not a scene, and a converted scene named as an image.
     let readme = write(dir, "README.md", "# Not a scene\n\nSome text.\n");
     refused(
