@@ -723,27 +723,33 @@ const RESUME_OPTIONS: [&str; 5] = [
     "--checkpoint-every",
 ];
 
-/// The arguments of the render a checkpoint continues: those it was started with (paths
-/// made absolute from the folder it was started in), then those given now.
-fn resumed_args(stored: &[String], cwd: &Path) -> Result<RenderArgs, String> {
-    let mut given = Vec::new();
-    let mut now = std::env::args()
+/// This process's arguments after `render`, less the options `drop` with their values
+/// (`--name value` or `--name=value`).
+fn render_args_without(drop: &[&str]) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut args = std::env::args()
         .skip(1)
         .skip_while(|a| a != "render")
         .skip(1);
-    while let Some(a) = now.next() {
-        if a == "--resume" {
-            now.next();
-            continue;
+    while let Some(a) = args.next() {
+        if drop.contains(&a.as_str()) {
+            args.next();
+        } else if !drop.iter().any(|d| a.starts_with(&format!("{d}="))) {
+            out.push(a);
         }
-        if a.starts_with("--resume=") {
-            continue;
-        }
+    }
+    out
+}
+
+/// The arguments of the render a checkpoint continues: those it was started with (paths
+/// made absolute from the folder it was started in), then those given now.
+fn resumed_args(stored: &[String], cwd: &Path) -> Result<RenderArgs, String> {
+    let given = render_args_without(&["--resume"]);
+    for a in &given {
         let name = a.split('=').next().unwrap_or("");
         if name.starts_with('-') && !RESUME_OPTIONS.contains(&name) {
             return Err(format!("`{a}` cannot be given with --resume: the render goes on with the scene and settings it was started with; only {} may change", RESUME_OPTIONS.join(", ")));
         }
-        given.push(a);
     }
     let argv = ["plenum", "render"]
         .into_iter()
@@ -772,21 +778,7 @@ fn resumed_args(stored: &[String], cwd: &Path) -> Result<RenderArgs, String> {
 /// The arguments after `render` as given, less those that belong to this run only, and the
 /// checkpoint's path where it was chosen for the user: what `--resume` starts from.
 fn arguments_to_resume(checkpoint: &Path, given: bool) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut args = std::env::args()
-        .skip(1)
-        .skip_while(|a| a != "render")
-        .skip(1);
-    while let Some(a) = args.next() {
-        if a == "--time-limit" || a == "--resume" {
-            args.next();
-            continue;
-        }
-        if a.starts_with("--time-limit=") || a.starts_with("--resume=") {
-            continue;
-        }
-        out.push(a);
-    }
+    let mut out = render_args_without(&["--time-limit", "--resume"]);
     if !given {
         out.push("--checkpoint".to_string());
         out.push(checkpoint.to_string_lossy().into_owned());
