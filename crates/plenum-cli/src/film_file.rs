@@ -1,22 +1,24 @@
 //! Film files (`.plf`): a render's raw film, exactly, with what it was rendered from. They
 //! are the checkpoints that `--resume` continues and the parts that `plenum merge` sums.
 //!
-//! Layout, little-endian: the magic line `PLENUM-FILM 1\n`; the header's length (u64) and
+//! Layout, little-endian: the magic line `PLENUM-FILM 2\n`; the header's length (u64) and
 //! the header, JSON (the scene file, a hash of the scene, the settings, the command line, the
-//! film's size and sample range); the film (per pixel Σw·L, Σw and ΣL as i128, the sample
-//! count as u32, and Σ Y and Σ Y² as f64; then a byte per pixel of passes done; the open
-//! flags of sampling by variance; the splat sums as i64); and last an FNV-1a hash of all
-//! that precedes it, so that a file cut short or damaged is refused, not read.
+//! film's size and sample range); the film, each list after its length as u64 (per pixel
+//! Σw·L, Σw and ΣL as i128, the sample count as u32, and Σ Y and Σ Y² as f64; a byte per
+//! pixel of passes done; the open flags of sampling by variance; the splat sums as i64;
+//! SPPM's statistics, after its iterations done (u32) and photons per iteration (u64): per
+//! pixel r, N, τ and L_d as f64); and last an FNV-1a hash of all that precedes it, so that a
+//! file cut short or damaged is refused, not read.
 //!
 //! A checkpoint is written to `NAME.tmp`, synced, and renamed over `NAME`: a crash at any
 //! moment leaves either the previous checkpoint or the new one, whole.
 
-use plenum_core::raw_film::{PixelSums, RawFilm};
+use plenum_core::raw_film::{PhotonStatistics, PixelSums, Progressive, RawFilm};
 use serde_json::{json, Value};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-const MAGIC: &[u8] = b"PLENUM-FILM 1\n";
+const MAGIC: &[u8] = b"PLENUM-FILM 2\n";
 
 /// What a film was rendered from: the same scene and settings must go on with it.
 #[derive(Clone, Debug, PartialEq)]
@@ -72,6 +74,7 @@ pub fn encode(film: &RawFilm, p: &Provenance) -> Vec<u8> {
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&(header.len() as u64).to_le_bytes());
     out.extend_from_slice(header.as_bytes());
+    out.extend_from_slice(&(film.pixels.len() as u64).to_le_bytes());
     for px in &film.pixels {
         for v in px.weighted.iter().chain([&px.weight]).chain(&px.plain) {
             out.extend_from_slice(&v.to_le_bytes());
@@ -80,6 +83,7 @@ pub fn encode(film: &RawFilm, p: &Provenance) -> Vec<u8> {
         out.extend_from_slice(&px.luminance.to_le_bytes());
         out.extend_from_slice(&px.luminance_squared.to_le_bytes());
     }
+    out.extend_from_slice(&(film.stages.len() as u64).to_le_bytes());
     out.extend_from_slice(&film.stages);
     out.extend_from_slice(&(film.open.len() as u64).to_le_bytes());
     out.extend(film.open.iter().map(|&o| o as u8));
@@ -87,6 +91,23 @@ pub fn encode(film: &RawFilm, p: &Provenance) -> Vec<u8> {
     for s in &film.splats {
         for v in s {
             out.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    match &film.progressive {
+        None => out.extend_from_slice(&0u64.to_le_bytes()),
+        Some(p) => {
+            out.extend_from_slice(&(p.pixels.len() as u64).to_le_bytes());
+            out.extend_from_slice(&p.iterations.to_le_bytes());
+            out.extend_from_slice(&p.photons_per_iteration.to_le_bytes());
+            for px in &p.pixels {
+                let values = [px.radius, px.photons]
+                    .into_iter()
+                    .chain(px.flux)
+                    .chain(px.direct);
+                for v in values {
+                    out.extend_from_slice(&v.to_le_bytes());
+                }
+            }
         }
     }
     let mut hash = Fnv::new();
@@ -120,11 +141,23 @@ impl<'a> Reader<'a> {
     fn u64(&mut self, what: &str) -> Result<u64, String> {
         Ok(u64::from_le_bytes(self.array(what)?))
     }
+
+    /// The length of a list of `what`, which must be `n` or, where allowed, 0.
+    fn length(&mut self, what: &str, n: usize, may_be_empty: bool) -> Result<usize, String> {
+        match self.u64(what)? {
+            0 if may_be_empty => Ok(0),
+            l if l == n as u64 => Ok(n),
+            _ => Err(format!("its {what} do not match its size")),
+        }
+    }
 }
 
 pub fn decode(bytes: &[u8]) -> Result<(RawFilm, Provenance), String> {
     if !bytes.starts_with(MAGIC) {
-        return Err("not a Plenum film file (it does not begin with `PLENUM-FILM 1`)".to_string());
+        if bytes.starts_with(b"PLENUM-FILM ") {
+            return Err("it was written by another version of Plenum: render it again".to_string());
+        }
+        return Err("not a Plenum film file (it does not begin with `PLENUM-FILM 2`)".to_string());
     }
     let body = bytes.len().checked_sub(8).ok_or("it is cut short")?;
     let mut hash = Fnv::new();
@@ -178,6 +211,9 @@ pub fn decode(bytes: &[u8]) -> Result<(RawFilm, Provenance), String> {
         .ok_or("its size does not match its length")?;
     let mut film = RawFilm::new(width, height, corners, samples);
     film.spp = number("spp")? as u32;
+    // SPPM's films hold no per-sample sums: its lists are empty.
+    let sums = r.length("pixels", n, true)?;
+    film.pixels.truncate(sums);
     for px in film.pixels.iter_mut() {
         let b = r.take(7 * 16 + 4 + 16, "the pixels")?;
         let i128_at =
@@ -191,25 +227,44 @@ pub fn decode(bytes: &[u8]) -> Result<(RawFilm, Provenance), String> {
             luminance_squared: f64::from_le_bytes(b[124..132].try_into().expect("8")),
         };
     }
-    film.stages = r.take(n, "the passes")?.to_vec();
-    let open = r.u64("the open flags")? as usize;
-    if open != 0 && open != n {
-        return Err("its open flags do not match its size".to_string());
-    }
+    let stages = r.length("passes", sums, false)?;
+    film.stages = r.take(stages, "the passes")?.to_vec();
+    let open = r.length("open flags", n, true)?;
     film.open = r
         .take(open, "the open flags")?
         .iter()
         .map(|&b| b != 0)
         .collect();
-    let splats = r.u64("the splats")? as usize;
-    if splats != 0 && splats != n {
-        return Err("its splats do not match its size".to_string());
-    }
+    let splats = r.length("splats", n, true)?;
     film.splats = Vec::with_capacity(splats);
     for _ in 0..splats {
         let b = r.take(24, "the splats")?;
         let at = |i: usize| i64::from_le_bytes(b[i * 8..i * 8 + 8].try_into().expect("8"));
         film.splats.push([at(0), at(1), at(2)]);
+    }
+    let progressive = r.length("SPPM statistics", n, true)?;
+    if (progressive == 0) != (sums == n) {
+        return Err("it holds neither per-sample sums nor SPPM's statistics in full".to_string());
+    }
+    if progressive > 0 {
+        let iterations = u32::from_le_bytes(r.array("the SPPM iterations")?);
+        let photons_per_iteration = r.u64("the SPPM photon count")?;
+        let mut pixels = Vec::with_capacity(progressive);
+        for _ in 0..progressive {
+            let b = r.take(8 * 8, "the SPPM statistics")?;
+            let at = |i: usize| f64::from_le_bytes(b[i * 8..i * 8 + 8].try_into().expect("8"));
+            pixels.push(PhotonStatistics {
+                radius: at(0),
+                photons: at(1),
+                flux: [at(2), at(3), at(4)],
+                direct: [at(5), at(6), at(7)],
+            });
+        }
+        film.progressive = Some(Progressive {
+            iterations,
+            photons_per_iteration,
+            pixels,
+        });
     }
     if r.at != body {
         return Err("it has bytes after its film".to_string());
@@ -274,26 +329,65 @@ mod tests {
         (film, p)
     }
 
+    /// An SPPM film after 3 of 5 iterations.
+    fn sppm_sample() -> (RawFilm, Provenance) {
+        let mut film = RawFilm::progressive(3, 2, 5, 1234);
+        let state = film.progressive.as_mut().unwrap();
+        state.iterations = 3;
+        for (i, px) in state.pixels.iter_mut().enumerate() {
+            let t = i as f64;
+            *px = PhotonStatistics {
+                radius: 0.1 / (t + 1.0),
+                photons: t * 2.0 / 3.0,
+                flux: [t, 1e-300, -0.0],
+                direct: [f64::MIN_POSITIVE, 3.5, t * t],
+            };
+        }
+        (film, sample().1)
+    }
+
     #[test]
     fn round_trip_is_exact() {
-        let (film, p) = sample();
-        let (back, q) = decode(&encode(&film, &p)).unwrap();
-        assert_eq!(back, film);
-        assert_eq!(q, p);
+        for (film, p) in [sample(), sppm_sample()] {
+            let (back, q) = decode(&encode(&film, &p)).unwrap();
+            assert_eq!(back, film);
+            assert_eq!(q, p);
+        }
+        // Bit for bit, -0.0 included.
+        let (film, p) = sppm_sample();
+        let (back, _) = decode(&encode(&film, &p)).unwrap();
+        let bits = |f: &RawFilm| -> Vec<u64> {
+            let s = f.progressive.as_ref().unwrap();
+            s.pixels
+                .iter()
+                .flat_map(|p| p.flux.map(f64::to_bits))
+                .collect()
+        };
+        assert_eq!(bits(&back), bits(&film));
     }
 
     /// Any byte changed or any length cut off is refused, never read as another film.
     #[test]
     fn damage_is_refused() {
+        for (film, p) in [sample(), sppm_sample()] {
+            let bytes = encode(&film, &p);
+            for i in (0..bytes.len()).step_by(7) {
+                let mut b = bytes.clone();
+                b[i] ^= 0x10;
+                assert!(decode(&b).is_err(), "byte {i} changed");
+            }
+            for len in (0..bytes.len()).step_by(5) {
+                assert!(decode(&bytes[..len]).is_err(), "cut at {len}");
+            }
+        }
+    }
+
+    #[test]
+    fn films_of_another_version_are_refused_by_name() {
         let (film, p) = sample();
-        let bytes = encode(&film, &p);
-        for i in (0..bytes.len()).step_by(7) {
-            let mut b = bytes.clone();
-            b[i] ^= 0x10;
-            assert!(decode(&b).is_err(), "byte {i} changed");
-        }
-        for len in (0..bytes.len()).step_by(5) {
-            assert!(decode(&bytes[..len]).is_err(), "cut at {len}");
-        }
+        let mut bytes = encode(&film, &p);
+        bytes[12] = b'1';
+        let e = decode(&bytes).unwrap_err();
+        assert!(e.contains("another version of Plenum"), "{e}");
     }
 }

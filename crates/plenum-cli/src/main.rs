@@ -16,7 +16,7 @@ use plenum_core::integrator::{ColorMode, IntegratorConfig, IntegratorKind, MAX_D
 use plenum_core::light_sampler::LightSamplerKind;
 use plenum_core::raw_film::RawFilm;
 use plenum_core::render::{
-    new_film, render, render_film, Adaptive, RenderControl, RenderSettings, MAX_SUBDIVISION,
+    new_film, render_film, Adaptive, RenderControl, RenderSettings, MAX_SUBDIVISION,
 };
 use plenum_core::sampling::{Filter, FilterKind, PixelSampler, SamplerKind, MAX_SPP};
 use plenum_scene::{builtin_scene, load_scene, LoadedScene};
@@ -907,8 +907,8 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
             .map(|_| args.output.with_extension(FILM_EXTENSION))
     });
     let keeps_film = checkpoint.is_some() || args.samples.is_some() || film_output;
-    if keeps_film && settings.integrator.kind == IntegratorKind::Sppm {
-        return refuse("integrator `sppm` keeps its state per iteration (radii, photon counts), not per pixel sample: checkpoints, --time-limit, --samples and film output are not available with it".to_string());
+    if args.samples.is_some() && settings.integrator.kind == IntegratorKind::Sppm {
+        return refuse("--samples cannot split integrator `sppm`: each iteration gathers within the radii the iterations before it left, so its iterations cannot be rendered apart (render it whole; --checkpoint keeps it safe)".to_string());
     }
     if keeps_film && settings.integrator.strategies {
         return refuse("--write-strategies cannot be combined with checkpoints, --time-limit, --samples or film output: the strategy images are not kept in the film".to_string());
@@ -1043,9 +1043,6 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
         }
     };
     let output = pool.install(|| {
-        if settings.integrator.kind == IntegratorKind::Sppm {
-            return render(&loaded.scene, &settings, &CANCEL, &progress);
-        }
         let control = RenderControl {
             cancel: &CANCEL,
             progress: &progress,

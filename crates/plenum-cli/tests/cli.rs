@@ -1013,9 +1013,60 @@ fn checkpoints_stop_resume_and_refuse_what_does_not_match() {
     assert!(std::fs::read(dir.join("out.pfm")).unwrap() == reference);
     assert!(!checkpoint.exists());
 
-    // What keeps no film per pixel sample is refused.
-    refused(&["--integrator", "sppm", "--checkpoint", "x.plf"], "sppm");
     refused(&["--checkpoint", "x.png"], "name the checkpoint .plf");
+}
+
+/// SPPM stops at its time limit after a whole iteration, with an image and a checkpoint of
+/// every pixel's radius, photons, flux and direct light, and resumes from it to the bytes of
+/// one render; --samples cannot split it.
+#[test]
+fn sppm_stops_and_resumes_to_the_bytes_of_one_render() {
+    let tmp = temp_dir("sppm-checkpoint");
+    let dir = tmp.path();
+    let mut args = cornell_args("64", "150");
+    args.extend(["--integrator", "sppm", "--sppm-photons", "1500"].map(String::from));
+    let run = |extra: &[&str]| {
+        plenum()
+            .current_dir(dir)
+            .arg("render")
+            .args(&args)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = run(&["-o", "reference.pfm"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let reference = std::fs::read(dir.join("reference.pfm")).unwrap();
+
+    let o = run(&[
+        "-o",
+        "out.pfm",
+        "--time-limit",
+        "0.2",
+        "--checkpoint-every",
+        "0.05",
+    ]);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    let checkpoint = dir.join("out.plf");
+    assert!(checkpoint.exists());
+    let partial = std::fs::read(dir.join("out.pfm")).unwrap();
+    assert!(partial != reference, "the time limit stopped it early");
+    let o = plenum()
+        .current_dir(dir)
+        .args(["render", "--resume", "out.plf"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::read(dir.join("out.pfm")).unwrap() == reference);
+    assert!(!checkpoint.exists());
+
+    let o = run(&["-o", "part.plf", "--samples", "0..2"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("cannot split integrator `sppm`"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 /// Sample ranges rendered apart (as a farm's tasks would) and merged give the bytes of one

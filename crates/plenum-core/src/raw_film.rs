@@ -7,6 +7,11 @@
 //! ranges on several machines and merged, therefore sums to the same integers as one
 //! uninterrupted render and resolves to the same bytes. (Splats are summed the same way, in
 //! [`SplatBuffer`](crate::film::SplatBuffer).)
+//!
+//! Stochastic progressive photon mapping keeps other state: per pixel its gather radius, the
+//! photons and flux it has kept, and the light its camera passes found, after whole
+//! iterations ([`Progressive`]). Each iteration continues from the last one's radii, so an
+//! SPPM film can be continued but not split.
 
 use crate::color::Color;
 use crate::film::Film;
@@ -123,6 +128,50 @@ pub struct RawFilm {
     /// Splat sums per pixel, in [`SplatBuffer`](crate::film::SplatBuffer)'s fixed point;
     /// empty for integrators that do not splat.
     pub splats: Vec<[i64; 3]>,
+    /// SPPM's state, whose iterations are `samples`; its `pixels` and `stages` are empty.
+    pub progressive: Option<Progressive>,
+}
+
+/// One pixel of stochastic progressive photon mapping (Hachisuka and Jensen 2009) between
+/// iterations.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhotonStatistics {
+    /// The gather radius r; 0 until the pixel's first visible point sets it.
+    pub radius: f64,
+    /// The photons kept, N.
+    pub photons: f64,
+    /// The flux kept, τ, linear sRGB.
+    pub flux: [f64; 3],
+    /// The sum over iterations of the light the camera passes found, linear sRGB.
+    pub direct: [f64; 3],
+}
+
+/// SPPM's film: every pixel's statistics after `iterations` whole iterations.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Progressive {
+    pub iterations: u32,
+    /// Photon paths traced per iteration.
+    pub photons_per_iteration: u64,
+    pub pixels: Vec<PhotonStatistics>,
+}
+
+impl Progressive {
+    /// A pixel's estimate: L_d / iterations + τ / (N_e π r²), N_e the photon paths of all
+    /// iterations.
+    pub fn value(&self, px: &PhotonStatistics) -> Color {
+        let done = self.iterations.max(1) as f64;
+        let area = std::f64::consts::PI * px.radius * px.radius;
+        let emitted = done * self.photons_per_iteration as f64;
+        let l = |c: usize| {
+            let gathered = if area > 0.0 && emitted > 0.0 {
+                px.flux[c] / (emitted * area)
+            } else {
+                0.0
+            };
+            px.direct[c] / done + gathered
+        };
+        Color::new(l(0), l(1), l(2))
+    }
 }
 
 impl RawFilm {
@@ -138,12 +187,30 @@ impl RawFilm {
             stages: vec![0; n],
             open: Vec::new(),
             splats: Vec::new(),
+            progressive: None,
+        }
+    }
+
+    /// An empty SPPM film of `iterations` iterations, `photons` photon paths each.
+    pub fn progressive(width: u32, height: u32, iterations: u32, photons: u64) -> RawFilm {
+        RawFilm {
+            pixels: Vec::new(),
+            stages: Vec::new(),
+            progressive: Some(Progressive {
+                iterations: 0,
+                photons_per_iteration: photons,
+                pixels: vec![PhotonStatistics::default(); width as usize * height as usize],
+            }),
+            ..RawFilm::new(width, height, false, 0..iterations)
         }
     }
 
     /// Whether every pixel has finished `passes` passes.
     pub fn is_complete(&self, passes: u8) -> bool {
-        self.stages.iter().all(|&s| s >= passes)
+        match &self.progressive {
+            Some(p) => p.iterations >= self.samples.end,
+            None => self.stages.iter().all(|&s| s >= passes),
+        }
     }
 
     /// The image: each pixel's weighted mean plus its splats; for a corner grid, each pixel
@@ -151,6 +218,13 @@ impl RawFilm {
     /// pixel; a film of part of them is scaled up to its own.
     pub fn image(&self) -> Film {
         let mut film = Film::new(self.width, self.height);
+        if let Some(p) = &self.progressive {
+            for (i, px) in p.pixels.iter().enumerate() {
+                let w = self.width as usize;
+                film.set((i % w) as u32, (i / w) as u32, p.value(px));
+            }
+            return film;
+        }
         for y in 0..self.height {
             for x in 0..self.width {
                 let i = y as usize * self.width as usize + x as usize;
@@ -191,6 +265,9 @@ impl RawFilm {
         let Some(mut sum) = parts.next() else {
             return Err("nothing to merge".to_string());
         };
+        if sum.progressive.is_some() {
+            return Err(SPPM_UNSPLIT.to_string());
+        }
         if sum.corners || !sum.open.is_empty() {
             return Err("only renders with a fixed number of samples per pixel can be merged (not adaptive sampling or the SPD corners)".to_string());
         }
@@ -220,6 +297,9 @@ impl RawFilm {
                     a.end, b.start
                 ));
             }
+            if part.progressive.is_some() {
+                return Err(SPPM_UNSPLIT.to_string());
+            }
             if part.splats.len() != sum.splats.len()
                 || part.corners
                 || !part.open.is_empty()
@@ -246,6 +326,8 @@ impl RawFilm {
         Ok(sum)
     }
 }
+
+const SPPM_UNSPLIT: &str = "SPPM renders cannot be merged: each iteration gathers within the radii the iterations before it left, so iterations cannot be rendered apart (render it whole; --checkpoint keeps it safe)";
 
 #[cfg(test)]
 mod tests {

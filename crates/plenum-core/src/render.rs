@@ -144,8 +144,12 @@ pub struct RenderControl<'a> {
 }
 
 /// An empty film for `settings`, to hold sample indices `samples` of every pixel (of all
-/// `settings.sampler`'s samples; ignored by adaptive sampling and the SPD corners).
+/// `settings.sampler`'s samples; ignored by adaptive sampling and the SPD corners). SPPM's
+/// film holds all its iterations.
 pub fn new_film(settings: &RenderSettings, samples: Range<u32>) -> RawFilm {
+    if settings.integrator.kind == IntegratorKind::Sppm {
+        return crate::integrator::sppm::new_film(settings);
+    }
     let extra = u32::from(settings.corners);
     let mut film = RawFilm::new(
         settings.width + extra,
@@ -168,10 +172,6 @@ pub fn render(
     cancel: &AtomicBool,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> RenderOutput {
-    // SPPM's iterations do not fit the per-pixel loop: it has its own.
-    if settings.integrator.kind == IntegratorKind::Sppm {
-        return crate::integrator::sppm::render(scene, settings, cancel, progress);
-    }
     let mut film = new_film(settings, 0..settings.sampler.samples_per_pixel());
     let control = RenderControl {
         cancel,
@@ -182,18 +182,18 @@ pub fn render(
 }
 
 /// Renders into `film` (from [`new_film`], or a checkpoint of the same scene and settings):
-/// the pixels it does not yet hold in full, then the image of all it holds. Not for SPPM,
-/// whose state is per iteration, not per pixel sample.
+/// the pixels it does not yet hold in full (SPPM: the iterations), then the image of all it
+/// holds.
 pub fn render_film(
     scene: &Scene,
     settings: &RenderSettings,
     film: &mut RawFilm,
     mut control: RenderControl,
 ) -> RenderOutput {
-    debug_assert!(
-        settings.integrator.kind != IntegratorKind::Sppm,
-        "SPPM renders by `render`, iteration by iteration"
-    );
+    // SPPM's iterations do not fit the per-pixel loop: it has its own.
+    if settings.integrator.kind == IntegratorKind::Sppm {
+        return crate::integrator::sppm::render_film(scene, settings, film, control);
+    }
     // Splats are pixel values once divided by the light paths per pixel; the camera's
     // importance reaches as far beyond the image as the filter spreads them.
     let spp = settings.sampler.samples_per_pixel().max(1);

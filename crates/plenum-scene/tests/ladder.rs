@@ -477,7 +477,8 @@ fn render_stopping(
 
 /// Every method but SPPM sums its pixels in fixed point: a render stopped at any checkpoint
 /// or cancelled mid-way and continued from its film, or split into sample ranges rendered
-/// apart and merged, gives the same bytes as one render. With the box filter and with
+/// apart and merged, gives the same bytes as one render. SPPM continues from its
+/// statistics after whole iterations, to the same bytes. With the box filter and with
 /// Mitchell's (negative lobes, splats spread over several pixels), in both colour modes;
 /// adaptive sampling (Whitted's subdivision, and by variance over its two passes) resumes
 /// to the same bytes too.
@@ -578,6 +579,41 @@ fn every_method_resumes_and_merges_to_the_same_bytes() {
                 );
             }
         }
+    }
+    // SPPM continues from its statistics after any iteration, in both colour modes; its
+    // films are refused by merge (each iteration gathers within the radii the last left).
+    for color in [ColorMode::Rgb, ColorMode::Spectral] {
+        let mut s = settings_for(&l, IntegratorKind::Sppm, 4, color, 5);
+        (s.width, s.height) = (40, 34);
+        s.integrator.photon.sppm_photons = 2000;
+        let whole = draw(&l, &s);
+        let mut saved = Vec::new();
+        let mut film = new_film(&s, 0..4);
+        let image = render_stopping(&l, &s, &mut film, Some(&mut saved), None);
+        assert!(image == whole, "sppm {color:?}: a render that checkpoints");
+        assert_eq!(
+            saved.len(),
+            3,
+            "sppm {color:?}: a checkpoint after each iteration but the last"
+        );
+        for (i, f) in saved.iter().enumerate() {
+            let mut f = f.clone();
+            let image = render_stopping(&l, &s, &mut f, None, None);
+            assert!(
+                image == whole,
+                "sppm {color:?}: continued from checkpoint {i}"
+            );
+        }
+        let mut film = new_film(&s, 0..4);
+        render_stopping(&l, &s, &mut film, None, Some(2));
+        assert!(
+            !film.is_complete(1),
+            "sppm {color:?}: the cancel stopped it"
+        );
+        let image = render_stopping(&l, &s, &mut film, None, None);
+        assert!(image == whole, "sppm {color:?}: continued after a cancel");
+        let e = RawFilm::merge(vec![film.clone(), film]).unwrap_err();
+        assert!(e.contains("SPPM renders cannot be merged"), "{e}");
     }
 }
 

@@ -37,14 +37,15 @@ use super::{
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
 use crate::color::Color;
-use crate::film::Film;
 use crate::math::{offset_ray_origin, Ray, Vec3};
-use crate::render::{RenderOutput, RenderSettings};
+use crate::raw_film::{PhotonStatistics, RawFilm};
+use crate::render::{RenderControl, RenderOutput, RenderSettings};
 use crate::sampling::Rng;
 use crate::scene::Scene;
 use plenum_spectrum::{ColorMode, SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, AtomicI64, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicI64, AtomicU64, Ordering};
+use std::time::Instant;
 
 /// Photon paths traced per parallel chunk.
 const CHUNK: u64 = 4096;
@@ -98,17 +99,10 @@ impl VisiblePoint {
     }
 }
 
-/// A pixel's running estimate.
+/// A pixel's running estimate, and its visible point of the iteration under way.
 #[derive(Clone, Copy, Default)]
 struct PixelState {
-    /// The gather radius; 0 until the pixel's first visible point sets it.
-    radius: f64,
-    /// The photons kept, N.
-    n: f64,
-    /// The flux kept, τ, linear sRGB.
-    tau: [f64; 3],
-    /// The sum over iterations of the light the camera pass found, linear sRGB.
-    ld: [f64; 3],
+    stats: PhotonStatistics,
     vp: Option<VisiblePoint>,
 }
 
@@ -119,29 +113,49 @@ struct PhotonSums {
     m: AtomicU64,
 }
 
-/// Renders the scene by SPPM; `cancel` stops it between iterations, `progress(done,
-/// total)` is called after each.
-pub fn render(
+/// An empty SPPM film for `settings`: its iterations are the sampler's samples per pixel.
+pub fn new_film(settings: &RenderSettings) -> RawFilm {
+    RawFilm::progressive(
+        settings.width,
+        settings.height,
+        settings.sampler.samples_per_pixel().max(1),
+        photons_per_iteration(settings),
+    )
+}
+
+/// Renders the iterations `film` (from [`new_film`], or a checkpoint of it) does not yet
+/// hold. `control.cancel` stops it between iterations, `control.progress(done, total)` is
+/// called after each, and a checkpoint, when due, is taken between them.
+pub fn render_film(
     scene: &Scene,
     settings: &RenderSettings,
-    cancel: &AtomicBool,
-    progress: &(dyn Fn(usize, usize) + Sync),
+    film: &mut RawFilm,
+    control: RenderControl,
 ) -> RenderOutput {
     let (w, h) = (settings.width, settings.height);
     let camera = Camera::new(&scene.camera, w, h);
     let config = &settings.integrator;
-    let iterations = settings.sampler.samples_per_pixel().max(1);
-    let pixel_count = w as usize * h as usize;
-    let photons = photons_per_iteration(settings);
+    let iterations = film.samples.end;
+    let state = film
+        .progressive
+        .as_mut()
+        .expect("an SPPM film, from sppm::new_film");
+    let photons = state.photons_per_iteration;
     let alpha = config.photon.alpha;
     let tracer = PhotonTracer::new(scene, config);
-    let mut pixels = vec![PixelState::default(); pixel_count];
-    let sums: Vec<PhotonSums> = (0..pixel_count).map(|_| PhotonSums::default()).collect();
+    let mut pixels: Vec<PixelState> = state
+        .pixels
+        .iter()
+        .map(|&stats| PixelState { stats, vp: None })
+        .collect();
+    let sums: Vec<PhotonSums> = (0..pixels.len()).map(|_| PhotonSums::default()).collect();
     let mut grid = Grid::default();
     let mut counts = RayCounts::default();
-    let mut done = 0u32;
-    for iteration in 0..iterations {
-        if cancel.load(Ordering::Relaxed) {
+    let mut checkpoint = control.checkpoint;
+    let mut last_checkpoint = Instant::now();
+    let mut done = state.iterations;
+    for iteration in done..iterations {
+        if control.cancel.load(Ordering::Relaxed) {
             break;
         }
         let wl = iteration_wavelengths(settings, iteration);
@@ -166,45 +180,44 @@ pub fn render(
         let max_depth = config.max_depth;
         let pixels_now = &pixels;
         let grid_now = &grid;
-        let c = (0..photons.div_ceil(CHUNK))
-            .into_par_iter()
-            .map(|chunk| {
-                let mut c = RayCounts::default();
-                for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(photons) {
-                    let mut stream = PhotonTracer::stream(settings.seed, iteration, index);
-                    let mut photon_wl = wl;
-                    let time = camera.time(stream.next_1d());
-                    tracer.trace(time, &mut photon_wl, &mut stream, &mut c, |a, pwl| {
-                        if a.depth < 2 {
-                            return true;
-                        }
-                        for &i in grid_now.near(a.it.p) {
-                            let px = &pixels_now[i as usize];
-                            let Some(phi) = px
-                                .vp
-                                .as_ref()
-                                .and_then(|vp| vp.photon_flux(px.radius, a, pwl, max_depth))
-                            else {
-                                continue;
-                            };
-                            let s = &sums[i as usize];
-                            for (sum, v) in s.phi.iter().zip([phi.r, phi.g, phi.b]) {
-                                let units = (v / UNIT).round();
-                                if units.is_finite() && units != 0.0 {
-                                    sum.fetch_add(
-                                        units.clamp(-9e18, 9e18) as i64,
-                                        Ordering::Relaxed,
-                                    );
-                                }
+        let c =
+            (0..photons.div_ceil(CHUNK))
+                .into_par_iter()
+                .map(|chunk| {
+                    let mut c = RayCounts::default();
+                    for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(photons) {
+                        let mut stream = PhotonTracer::stream(settings.seed, iteration, index);
+                        let mut photon_wl = wl;
+                        let time = camera.time(stream.next_1d());
+                        tracer.trace(time, &mut photon_wl, &mut stream, &mut c, |a, pwl| {
+                            if a.depth < 2 {
+                                return true;
                             }
-                            s.m.fetch_add(1, Ordering::Relaxed);
-                        }
-                        true
-                    });
-                }
-                c
-            })
-            .reduce(RayCounts::default, add_counts);
+                            for &i in grid_now.near(a.it.p) {
+                                let px = &pixels_now[i as usize];
+                                let Some(phi) = px.vp.as_ref().and_then(|vp| {
+                                    vp.photon_flux(px.stats.radius, a, pwl, max_depth)
+                                }) else {
+                                    continue;
+                                };
+                                let s = &sums[i as usize];
+                                for (sum, v) in s.phi.iter().zip([phi.r, phi.g, phi.b]) {
+                                    let units = (v / UNIT).round();
+                                    if units.is_finite() && units != 0.0 {
+                                        sum.fetch_add(
+                                            units.clamp(-9e18, 9e18) as i64,
+                                            Ordering::Relaxed,
+                                        );
+                                    }
+                                }
+                                s.m.fetch_add(1, Ordering::Relaxed);
+                            }
+                            true
+                        });
+                    }
+                    c
+                })
+                .reduce(RayCounts::default, add_counts);
         counts.add(&c);
 
         pixels.par_iter_mut().zip(&sums).for_each(|(px, s)| {
@@ -213,40 +226,43 @@ pub fn render(
                 .phi
                 .each_ref()
                 .map(|v| v.swap(0, Ordering::Relaxed) as f64 * UNIT);
+            let k = &mut px.stats;
             if m > 0.0 {
-                let n = px.n + alpha * m;
-                let shrink2 = n / (px.n + m);
-                for (tau, phi) in px.tau.iter_mut().zip(phi) {
+                let n = k.photons + alpha * m;
+                let shrink2 = n / (k.photons + m);
+                for (tau, phi) in k.flux.iter_mut().zip(phi) {
                     *tau = (*tau + phi) * shrink2;
                 }
-                px.n = n;
-                px.radius *= shrink2.sqrt();
+                k.photons = n;
+                k.radius *= shrink2.sqrt();
             }
             px.vp = None;
         });
-        done += 1;
-        progress(done as usize, iterations as usize);
+        done = iteration + 1;
+        (control.progress)(done as usize, iterations as usize);
+        if let Some((every, save)) = checkpoint.as_mut() {
+            if done < iterations && last_checkpoint.elapsed() >= *every {
+                keep(film, &pixels, done);
+                save(film);
+                last_checkpoint = Instant::now();
+            }
+        }
     }
-
-    let mut film = Film::new(w, h);
-    let emitted_paths = done.max(1) as f64 * photons as f64;
-    for (i, px) in pixels.iter().enumerate() {
-        let area = std::f64::consts::PI * px.radius * px.radius;
-        let l = |c: usize| {
-            let gathered = if area > 0.0 {
-                px.tau[c] / (emitted_paths * area)
-            } else {
-                0.0
-            };
-            px.ld[c] / done.max(1) as f64 + gathered
-        };
-        film.set(i as u32 % w, i as u32 / w, Color::new(l(0), l(1), l(2)));
-    }
+    keep(film, &pixels, done);
     RenderOutput {
-        film,
+        film: film.image(),
         counts,
-        complete: done == iterations,
+        complete: film.is_complete(1),
         strategies: Vec::new(),
+    }
+}
+
+/// Writes the pixels' statistics after `done` iterations into the film.
+fn keep(film: &mut RawFilm, pixels: &[PixelState], done: u32) {
+    let state = film.progressive.as_mut().expect("an SPPM film");
+    state.iterations = done;
+    for (kept, px) in state.pixels.iter_mut().zip(pixels) {
+        *kept = px.stats;
     }
 }
 
@@ -288,7 +304,7 @@ pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> 
     let mut tree = RayTree::default();
     let mut counts = RayCounts::default();
     eye.camera_path(x, y, &mut px, &mut counts, Some(&mut tree));
-    let ld = Color::new(px.ld[0], px.ld[1], px.ld[2]);
+    let ld = Color::new(px.stats.direct[0], px.stats.direct[1], px.stats.direct[2]);
     let Some(vp) = px.vp else {
         return (tree, ld);
     };
@@ -305,7 +321,7 @@ pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> 
                 let time = camera.time(stream.next_1d());
                 tracer.trace(time, &mut photon_wl, &mut stream, &mut c, |a, pwl| {
                     if a.depth >= 2 {
-                        if let Some(phi) = vp.photon_flux(px.radius, a, pwl, max_depth) {
+                        if let Some(phi) = vp.photon_flux(px.stats.radius, a, pwl, max_depth) {
                             let photon = FoundPhoton {
                                 position: a.it.p,
                                 wi: a.wi,
@@ -324,11 +340,12 @@ pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> 
     let mut found: Vec<(FoundPhoton, Color)> = chunks.into_iter().flatten().collect();
     found.sort_by(|a, b| a.0.distance.total_cmp(&b.0.distance));
     let phi = found.iter().fold(Color::BLACK, |s, (_, f)| s + *f);
-    let estimate = phi * (1.0 / (photons as f64 * std::f64::consts::PI * px.radius * px.radius));
+    let estimate =
+        phi * (1.0 / (photons as f64 * std::f64::consts::PI * px.stats.radius * px.stats.radius));
     if let Some(node) = tree.nodes.last_mut() {
         node.photons = Some(PhotonGather {
             source: "SPPM photon pass",
-            radius: px.radius,
+            radius: px.stats.radius,
             photons: found.into_iter().map(|(p, _)| p).collect(),
             estimate,
         });
@@ -355,7 +372,7 @@ struct Eye<'a> {
 }
 
 impl Eye<'_> {
-    /// Traces pixel (x, y)'s camera path: adds the light it finds to `px.ld` and leaves its
+    /// Traces pixel (x, y)'s camera path: adds the light it finds to `px.stats.direct` and leaves its
     /// visible point in `px.vp`.
     fn camera_path(
         &self,
@@ -417,8 +434,8 @@ impl Eye<'_> {
                 if e <= max_depth {
                     l += beta * bsdf_sample_ld(scene, &it, wo, &bsdf, &wl, &mut stream, counts, t);
                 }
-                if px.radius == 0.0 {
-                    px.radius = match s.integrator.photon.radius {
+                if px.stats.radius == 0.0 {
+                    px.stats.radius = match s.integrator.photon.radius {
                         r if r > 0.0 => r,
                         _ => FOOTPRINT_PIXELS * self.camera.pixel_footprint(distance),
                     };
@@ -463,9 +480,9 @@ impl Eye<'_> {
             }
         }
         if l.is_finite() && c.r.is_finite() && c.g.is_finite() && c.b.is_finite() {
-            px.ld[0] += c.r;
-            px.ld[1] += c.g;
-            px.ld[2] += c.b;
+            px.stats.direct[0] += c.r;
+            px.stats.direct[1] += c.g;
+            px.stats.direct[2] += c.b;
         } else {
             counts.invalid += 1;
         }
@@ -502,7 +519,7 @@ impl Grid {
             if let Some(vp) = &px.vp {
                 lo = lo.min(vp.p);
                 hi = hi.max(vp.p);
-                r_max = r_max.max(px.radius);
+                r_max = r_max.max(px.stats.radius);
                 count += 1;
             }
         }
@@ -516,7 +533,7 @@ impl Grid {
             pixels
                 .par_iter()
                 .enumerate()
-                .filter_map(|(i, px)| px.vp.as_ref().map(|vp| (i, vp.p, px.radius)))
+                .filter_map(|(i, px)| px.vp.as_ref().map(|vp| (i, vp.p, px.stats.radius)))
                 .flat_map_iter(move |(i, p, r)| {
                     let a = cell_of(p - Vec3::splat(r), origin, cell);
                     let b = cell_of(p + Vec3::splat(r), origin, cell);
