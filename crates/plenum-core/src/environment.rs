@@ -11,6 +11,10 @@
 //!   texel column i covers φ ∈ [2πi/W, 2π(i+1)/W], φ measured from +x towards +y, and row j
 //!   (from the top) covers θ ∈ [πj/H, π(j+1)/H], θ measured from +z: the top row circles
 //!   +z, the bottom row −z. Image coordinates (s, t) = (φ/2π, θ/π); dω = 2π² sin θ ds dt.
+//! - [`EnvironmentLayout::LatLongPoles`], the same map as Mitsuba 3's `envmap` reads it:
+//!   columns as above, but the rows' centres run from the pole to the pole, row 0 at θ = 0
+//!   and row H − 1 at θ = π (row j at θ = πj/(H − 1)). The two layouts differ by up to half a
+//!   texel in θ; a scene made for Mitsuba renders as Mitsuba renders it only in this one.
 //! - [`EnvironmentLayout::EqualArea`], the octahedral equal-area square of Clarberg 2008
 //!   ("Fast Equal-Area Mapping of the (Hemi)Sphere using SIMD"), pbrt-v4's own layout for
 //!   image infinite lights: (s, t) along the width and down the height go through
@@ -44,6 +48,8 @@ use crate::sampling::{
 pub enum EnvironmentLayout {
     /// Equirectangular: (s, t) = (φ/2π, θ/π), θ from the map's +z.
     LatLong,
+    /// Equirectangular with the first and last rows' centres on the poles (Mitsuba 3).
+    LatLongPoles,
     /// Clarberg's octahedral equal-area square; width and height must be equal.
     EqualArea,
 }
@@ -179,7 +185,7 @@ impl EnvironmentMap {
     /// The solid angle of a texel in row `j`, in steradians.
     fn texel_solid_angle(&self, j: usize) -> f64 {
         match self.layout {
-            EnvironmentLayout::LatLong => {
+            EnvironmentLayout::LatLong | EnvironmentLayout::LatLongPoles => {
                 let theta = |row: usize| PI * row as f64 / self.height as f64;
                 TAU / self.width as f64 * (theta(j).cos() - theta(j + 1).cos())
             }
@@ -191,7 +197,7 @@ impl EnvironmentMap {
     /// wraps around in φ and clamps at the poles; the equal-area square folds over its edges.
     fn texel(&self, x: i64, y: i64) -> [f64; 3] {
         let (i, j) = match self.layout {
-            EnvironmentLayout::LatLong => (
+            EnvironmentLayout::LatLong | EnvironmentLayout::LatLongPoles => (
                 x.rem_euclid(self.width as i64) as usize,
                 y.clamp(0, self.height as i64 - 1) as usize,
             ),
@@ -203,7 +209,10 @@ impl EnvironmentMap {
     /// The bilinearly filtered, scaled radiance at image coordinates (s, t) ∈ [0, 1]².
     fn lookup(&self, p: [f64; 2]) -> [f64; 3] {
         let x = p[0] * self.width as f64 - 0.5;
-        let y = p[1] * self.height as f64 - 0.5;
+        let y = match self.layout {
+            EnvironmentLayout::LatLongPoles => p[1] * (self.height as f64 - 1.0),
+            _ => p[1] * self.height as f64 - 0.5,
+        };
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
@@ -222,7 +231,7 @@ impl EnvironmentMap {
     /// Image coordinates of a direction of the map's own frame (unit length).
     fn to_square(&self, local: Vec3) -> [f64; 2] {
         match self.layout {
-            EnvironmentLayout::LatLong => {
+            EnvironmentLayout::LatLong | EnvironmentLayout::LatLongPoles => {
                 let theta = local.z.clamp(-1.0, 1.0).acos();
                 let phi = local.y.atan2(local.x).rem_euclid(TAU);
                 [(phi / TAU).min(1.0), theta * FRAC_1_PI]
@@ -247,7 +256,7 @@ impl EnvironmentMap {
             return None;
         }
         let (local, pdf) = match self.layout {
-            EnvironmentLayout::LatLong => {
+            EnvironmentLayout::LatLong | EnvironmentLayout::LatLongPoles => {
                 let (sin_theta, cos_theta) = (PI * p[1]).sin_cos();
                 if sin_theta <= 0.0 {
                     return None;
@@ -270,7 +279,7 @@ impl EnvironmentMap {
         let p = self.to_square(local);
         let pdf_square = self.distribution.pdf(p);
         match self.layout {
-            EnvironmentLayout::LatLong => {
+            EnvironmentLayout::LatLong | EnvironmentLayout::LatLongPoles => {
                 let sin_theta = (1.0 - local.z * local.z).max(0.0).sqrt();
                 if sin_theta <= 0.0 {
                     return 0.0;
@@ -389,6 +398,42 @@ mod tests {
     #[test]
     fn chi_square_lat_long_environment() {
         chi_square(&maps()[0], "lat-long environment map");
+    }
+
+    #[test]
+    fn chi_square_lat_long_poles_environment() {
+        let map = EnvironmentMap::new(
+            32,
+            16,
+            lat_long_texels(),
+            EnvironmentLayout::LatLongPoles,
+            tilted_frame(),
+            1.5,
+        )
+        .unwrap();
+        chi_square(&map, "lat-long environment map, rows on the poles");
+    }
+
+    /// Row j's value is found at θ = π(j + ½)/H in the lat-long layout and at θ = πj/(H − 1)
+    /// in Mitsuba's: the first and last rows on the poles.
+    #[test]
+    fn lat_long_rows_sit_where_each_layout_puts_them() {
+        let (w, h) = (8, 5);
+        let texels: Vec<[f32; 3]> = (0..w * h).map(|i| [(i / w) as f32; 3]).collect();
+        let frame = Frame::from_z(Vec3::Z);
+        let at = |layout, theta: f64| {
+            let map = EnvironmentMap::new(w, h, texels.clone(), layout, frame, 1.0).unwrap();
+            map.radiance(Vec3::new(theta.sin(), 0.0, theta.cos()))[0]
+        };
+        for j in 0..h {
+            let centre = PI * (j as f64 + 0.5) / h as f64;
+            assert!((at(EnvironmentLayout::LatLong, centre) - j as f64).abs() < 1e-9);
+            let pole_aligned = PI * j as f64 / (h - 1) as f64;
+            assert!((at(EnvironmentLayout::LatLongPoles, pole_aligned) - j as f64).abs() < 1e-9);
+        }
+        // Between rows: linear in θ.
+        let mid = PI * 1.5 / (h - 1) as f64;
+        assert!((at(EnvironmentLayout::LatLongPoles, mid) - 1.5).abs() < 1e-9);
     }
 
     #[test]

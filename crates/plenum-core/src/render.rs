@@ -74,9 +74,6 @@ impl RenderSettings {
                 return Err("integrator `sppm` gathers each pixel over its own square (a box filter of one pixel); other filters are not available with it".to_string());
             }
         }
-        if kind == IntegratorKind::Light && matches!(self.sampler, PixelSampler::Cook16 { .. }) {
-            return Err("integrator `light` cannot use the cook16 sampler: Cook's pairing of regions is one table for every pixel, which would tie a light path's choices (light, point, direction) together across the whole image and bias it (13 % dark in a furnace); use jittered, random or sobol".to_string());
-        }
         if kind.splats() {
             let name = kind.name();
             if self.adaptive.is_some() {

@@ -814,12 +814,13 @@ impl<'s> Reader<'s> {
             None => EnvironmentLayout::LatLong,
             Some(l) => match self.src.string(l)? {
                 "latlong" => EnvironmentLayout::LatLong,
+                "latlong-poles" => EnvironmentLayout::LatLongPoles,
                 "equalarea" => EnvironmentLayout::EqualArea,
                 other => {
                     return Err(self
                         .src
                         .error(l.span(), format!("unknown layout `{other}`"))
-                        .with_help("expected `latlong` or `equalarea`"))
+                        .with_help("expected `latlong`, `latlong-poles` or `equalarea`"))
                 }
             },
         };

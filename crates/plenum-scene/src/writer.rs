@@ -224,6 +224,7 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
             Light::Environment { map, .. } => {
                 let layout = match map.map.layout() {
                     plenum_core::environment::EnvironmentLayout::LatLong => "latlong",
+                    plenum_core::environment::EnvironmentLayout::LatLongPoles => "latlong-poles",
                     plenum_core::environment::EnvironmentLayout::EqualArea => "equalarea",
                 };
                 let _ = writeln!(

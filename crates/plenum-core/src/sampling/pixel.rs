@@ -13,9 +13,14 @@
 //!   dimensions' cells are shuffled per pixel and dimension, so the lens cell of a sample does
 //!   not follow from its pixel cell.
 //! - `cook16`: Cook's correlated scheme (Cook 1986): the pixel and every direction domain split
-//!   into 16 regions; sub-pixel m pairs with region m of every domain through one fixed table
-//!   per dimension (the same for every pixel), each sample jittered inside its region. More
-//!   than 16 samples repeat the pattern with fresh jitter.
+//!   into 16 regions; sub-pixel m pairs with one region of every domain through a table per
+//!   dimension, each region taken once in 16 samples, each sample jittered inside its region.
+//!   Cook used one table for the whole image. Then the regions of one dimension always meet
+//!   the same regions of the next, in every pixel and for every seed, so a discrete choice
+//!   made in one (a light, a lobe, Russian roulette) always sees the same part of the next: a
+//!   bias that no number of samples removes. Here each pixel, and each pass of 16 samples,
+//!   draws its own tables (a Latin hypercube over the regions: every pairing equally likely,
+//!   so the estimate is unbiased), and the pairing sample m ↔ region table[m] stays.
 //! - `sobol`: Owen-scrambled Sobol points (Burley 2020); each dimension takes a 2-D (or 1-D)
 //!   Sobol set under its own scramble seed, so every pair is well stratified ("padding").
 //!
@@ -197,7 +202,7 @@ impl SampleStream {
                 (s as f64 + self.rng.uniform()) / strata as f64
             }
             PixelSampler::Cook16 { .. } => {
-                let s = permute(i % 16, 16, mix32(d as u64));
+                let s = permute(i % 16, 16, self.pass_key(d));
                 (s as f64 + self.rng.uniform()) / 16.0
             }
             PixelSampler::Sobol { .. } => sobol_burley::sample(i, 0, self.key(d)) as f64,
@@ -216,13 +221,13 @@ impl SampleStream {
                 self.cell_2d(cell, n)
             }
             PixelSampler::Cook16 { .. } => {
-                // The table is the same for every pixel (Cook's fixed pairing); the pixel
-                // itself (d = 0) takes regions in order.
+                // The pixel itself (d = 0) takes its regions in order: sample m in
+                // sub-pixel m, paired through this pixel's and pass's tables.
                 let m = i % 16;
                 let region = if d == 0 {
                     m
                 } else {
-                    permute(m, 16, mix32(d as u64))
+                    permute(m, 16, self.pass_key(d))
                 };
                 self.cell_2d(region, 4)
             }
@@ -246,6 +251,11 @@ impl SampleStream {
     /// The scramble or shuffle key of dimension `d` in this pixel.
     fn key(&self, d: u32) -> u32 {
         mix32(((self.pixel_key as u64) << 32) | d as u64)
+    }
+
+    /// cook16's table key of dimension `d` in this pixel and pass of 16 samples.
+    fn pass_key(&self, d: u32) -> u32 {
+        mix32(((self.key(d) as u64) << 32) | (self.index / 16) as u64)
     }
 }
 
@@ -356,24 +366,74 @@ mod tests {
     }
 
     /// Jittered: the lens cell of a sample is not its pixel cell (shuffled per dimension);
-    /// cook16: the pairing is the same table in every pixel.
+    /// cook16: sample m pairs sub-pixel m with a region of each domain, by a table that
+    /// differs from pixel to pixel and from one pass of 16 to the next.
     #[test]
-    fn jittered_shuffles_dimensions_and_cook16_pairs_them_by_a_fixed_table() {
+    fn jittered_shuffles_dimensions_and_cook16_draws_its_tables_per_pixel_and_pass() {
         let cell = |v: [f64; 2]| (v[0] * 4.0) as u32 + 4 * (v[1] * 4.0) as u32;
-        let pairs = |s: PixelSampler, x: u32| -> Vec<(u32, u32)> {
+        let pairs = |s: PixelSampler, x: u32, pass: u32| -> Vec<(u32, u32)> {
             (0..16)
                 .map(|i| {
-                    let mut st = s.stream(1, x, 0, i);
+                    let mut st = s.stream(1, x, 0, 16 * pass + i);
                     (cell(st.pixel()), cell(st.next_2d()))
                 })
                 .collect()
         };
         let j = PixelSampler::Jittered { n: 4 };
-        assert!(pairs(j, 0).iter().any(|(a, b)| a != b));
-        assert_ne!(pairs(j, 0), pairs(j, 1));
+        assert!(pairs(j, 0, 0).iter().any(|(a, b)| a != b));
+        assert_ne!(pairs(j, 0, 0), pairs(j, 1, 0));
         let c = PixelSampler::Cook16 { passes: 2 };
-        assert_eq!(pairs(c, 0), pairs(c, 7));
-        assert!(pairs(c, 0).iter().any(|(a, b)| a != b));
+        for x in [0, 7] {
+            for pass in [0, 1] {
+                let p = pairs(c, x, pass);
+                assert!(p.iter().enumerate().all(|(m, &(a, _))| a == m as u32));
+            }
+        }
+        assert_ne!(pairs(c, 0, 0), pairs(c, 7, 0));
+        assert_ne!(pairs(c, 0, 0), pairs(c, 0, 1));
+    }
+
+    /// A choice made in one dimension meets the next without bias: the mean over pixels of
+    /// [u_d < ½]·[u_(d+1) < ½] is ¼ for every pair of consecutive dimensions (1-D and 2-D
+    /// alike). Cook's single table gave each pair a fixed count out of 16 in every pixel
+    /// (3/16 or 5/16 instead of 4/16, whatever the samples). 4096 pixels of 16 samples, seed 3;
+    /// a pixel's estimate has standard deviation 0.065 (hypergeometric), the mean 0.001:
+    /// tolerance 0.005.
+    #[test]
+    fn cook16_pairs_dimensions_without_bias() {
+        let c = PixelSampler::Cook16 { passes: 1 };
+        let pixels = 4096u32;
+        for kind in ["1-D", "2-D"] {
+            let mut sums = [0.0; 8];
+            for p in 0..pixels {
+                for i in 0..16 {
+                    let mut st = c.stream(3, p % 64, p / 64, i);
+                    st.pixel();
+                    let u: Vec<f64> = (0..9)
+                        .map(|_| {
+                            if kind == "1-D" {
+                                st.next_1d()
+                            } else {
+                                st.next_2d()[0]
+                            }
+                        })
+                        .collect();
+                    for d in 0..8 {
+                        if u[d] < 0.5 && u[d + 1] < 0.5 {
+                            sums[d] += 1.0 / 16.0;
+                        }
+                    }
+                }
+            }
+            for (d, s) in sums.iter().enumerate() {
+                let m = s / pixels as f64;
+                assert!(
+                    (m - 0.25).abs() < 0.005,
+                    "{kind} dimensions {d}, {}: {m}",
+                    d + 1
+                );
+            }
+        }
     }
 
     #[test]

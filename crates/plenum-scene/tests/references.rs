@@ -1,0 +1,297 @@
+//! Every physically based method against Mitsuba 3's converged references of the six scenes
+//! in ../shared/data/references/features (specular, rough, mis, env, delta, lens; ported to
+//! the native format in tests/references/, matrix for matrix).
+//!
+//! The test of an image against its reference's noise, not a fixed tolerance, three ways:
+//! - Mitsuba's per-pixel z-test: at least 99.75 % of pixel channels within the bound
+//!   z ≤ Φ⁻¹(1 − α/2), α = 1 − 0.99^(1/N);
+//! - the image mean within 5σ of the reference's, per channel (a small bias spread over the
+//!   whole image hides in a pass rate);
+//! - every 16×16 block's mean within 6σ of the reference's (a regional bias, such as a
+//!   ceiling lit through a specular bounce, hides in the image mean).
+//!
+//! Renders are made at 128×128, half the reference's size: with the box filter a pixel is
+//! the mean of the radiance over its square, so the mean of a 2×2 block of reference pixels
+//! is exactly what a pixel of the half-size image estimates (its variance: the sum of the
+//! four variances ÷ 16). Each test makes `RENDERS` independent renders (seeds 1000…): their
+//! mean is the estimate and their sample variance ÷ `RENDERS` its variance.
+//!
+//! To look into a failure: `PLENUM_REFERENCE_SPP=N` renders N samples per render instead,
+//! and `PLENUM_REFERENCE_IMAGES=DIR` writes the estimate, the reference and a map of z (red
+//! where the estimate is high, blue where low) there as PNG, and prints each block that is
+//! the worst so far.
+
+mod common;
+
+use common::integrators::{draw, mean_and_variance, read_exr, settings_for, z_test};
+use plenum_core::integrator::{ColorMode, IntegratorKind};
+use plenum_core::render::RenderSettings;
+use plenum_scene::{load_scene, LoadedScene};
+use std::path::PathBuf;
+
+/// Independent renders per test: enough that the variance of their mean is known to a few
+/// per cent (15 degrees of freedom; with 8, the z-test's own tail passes fewer than 99.75 %).
+const RENDERS: u64 = 16;
+/// The rendered image's side, half the reference's.
+const SIZE: usize = 128;
+const BLOCK: usize = 16;
+
+/// A reference at half size: each pixel's mean and the variance of that mean.
+struct Reference {
+    mean: Vec<[f64; 3]>,
+    var: Vec<[f64; 3]>,
+}
+
+fn features() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/references/features")
+}
+
+/// The scene `name`, ported, and its reference halved; `None` (and a word) without
+/// ../shared.
+fn load(name: &str) -> Option<(LoadedScene, Reference)> {
+    let dir = features().join(name);
+    if !dir.join("reference.exr").exists() {
+        common::missing(&format!("../shared/data/references/features/{name}"));
+        return None;
+    }
+    let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/references")
+        .join(format!("{name}.toml"));
+    let l = load_scene(&scene).unwrap_or_else(|e| panic!("{e}"));
+    let full = read_exr(&dir.join("reference.exr"));
+    let full_var = read_exr(&dir.join("reference-variance.exr"));
+    assert_eq!(full.len(), 4 * SIZE * SIZE, "{name}: a 256×256 reference");
+    let half = |image: &[[f32; 3]], scale: f64| -> Vec<[f64; 3]> {
+        let mut out = vec![[0.0; 3]; SIZE * SIZE];
+        for y in 0..2 * SIZE {
+            for x in 0..2 * SIZE {
+                let p = image[y * 2 * SIZE + x];
+                let o = &mut out[(y / 2) * SIZE + x / 2];
+                for c in 0..3 {
+                    o[c] += p[c] as f64 * scale;
+                }
+            }
+        }
+        out
+    };
+    Some((
+        l,
+        Reference {
+            mean: half(&full, 0.25),
+            var: half(&full_var, 1.0 / 16.0),
+        },
+    ))
+}
+
+/// What the comparison found.
+struct Outcome {
+    pass_rate: f64,
+    squared_over_predicted: f64,
+    /// The image mean's difference from the reference's, in σ, per channel.
+    mean_sigma: [f64; 3],
+    mean_bias: [f64; 3],
+    /// The largest block deviation in σ, and where (block x, y, channel).
+    worst_block: (f64, usize, usize, usize),
+}
+
+/// Renders `name` by `kind` (`RENDERS` renders of `spp` samples, settings changed by
+/// `tweak`) and compares it with the reference.
+fn compare(
+    name: &str,
+    kind: IntegratorKind,
+    spp: u32,
+    tweak: impl Fn(&mut RenderSettings),
+) -> Option<Outcome> {
+    let (l, reference) = load(name)?;
+    let spp = std::env::var("PLENUM_REFERENCE_SPP")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(spp);
+    let images: Vec<Vec<[f32; 3]>> = (0..RENDERS)
+        .map(|i| {
+            let mut s = settings_for(&l, kind, spp, ColorMode::Rgb, 1000 + i);
+            (s.width, s.height) = (SIZE as u32, SIZE as u32);
+            tweak(&mut s);
+            draw(&l, &s)
+        })
+        .collect();
+    let (mean, var) = mean_and_variance(&images);
+    if let Some(dir) = std::env::var_os("PLENUM_REFERENCE_IMAGES") {
+        // For a person looking into a failure: the estimate, the reference and z per
+        // channel (red where the estimate is high, blue where low), side by side.
+        let dir = PathBuf::from(dir);
+        let to_f32 =
+            |v: &[[f64; 3]]| -> Vec<[f32; 3]> { v.iter().map(|p| p.map(|c| c as f32)).collect() };
+        let z: Vec<[f32; 3]> = (0..SIZE * SIZE)
+            .map(|i| {
+                let z = |c: usize| {
+                    (mean[i][c] - reference.mean[i][c])
+                        / (var[i][c] + reference.var[i][c]).sqrt().max(1e-12)
+                };
+                let g = (z(0) + z(1) + z(2)) as f32 / 3.0;
+                [(g / 5.0).max(0.0), 0.0, (-g / 5.0).max(0.0)]
+            })
+            .collect();
+        let size = SIZE as u32;
+        let tag = format!("{name}-{}", kind.name());
+        for (what, image, exposure) in [
+            ("estimate", to_f32(&mean), 0.0),
+            ("reference", to_f32(&reference.mean), 0.0),
+            ("z", z, 0.0),
+        ] {
+            let path = dir.join(format!("{tag}-{what}.png"));
+            plenum_image::write_image(&path, size, size, &image, exposure).unwrap();
+        }
+    }
+    let (pass_rate, squared_over_predicted, _) =
+        z_test(&mean, &var, &reference.mean, &reference.var);
+    // Means over regions: the difference and its σ, per channel.
+    let region = |x0: usize, y0: usize, side: usize, c: usize| -> (f64, f64) {
+        let (mut d, mut v) = (0.0, 0.0);
+        for y in y0..y0 + side {
+            for x in x0..x0 + side {
+                let i = y * SIZE + x;
+                d += mean[i][c] - reference.mean[i][c];
+                v += var[i][c] + reference.var[i][c];
+            }
+        }
+        let n = (side * side) as f64;
+        (d / n, v.sqrt() / n)
+    };
+    let mut mean_sigma = [0.0; 3];
+    let mut mean_bias = [0.0; 3];
+    for c in 0..3 {
+        let (d, sigma) = region(0, 0, SIZE, c);
+        mean_sigma[c] = d / sigma;
+        let reference_mean =
+            reference.mean.iter().map(|p| p[c]).sum::<f64>() / (SIZE * SIZE) as f64;
+        mean_bias[c] = d / reference_mean;
+    }
+    let mut worst_block = (0.0, 0, 0, 0);
+    for by in 0..SIZE / BLOCK {
+        for bx in 0..SIZE / BLOCK {
+            for c in 0..3 {
+                let (d, sigma) = region(bx * BLOCK, by * BLOCK, BLOCK, c);
+                let z = if sigma > 0.0 {
+                    d / sigma
+                } else if d == 0.0 {
+                    0.0
+                } else {
+                    f64::INFINITY
+                };
+                if z.abs() > worst_block.0 {
+                    worst_block = (z.abs(), bx, by, c);
+                    if std::env::var_os("PLENUM_REFERENCE_IMAGES").is_some() {
+                        let r = region_reference(&reference, bx * BLOCK, by * BLOCK, BLOCK, c);
+                        eprintln!(
+                            "block ({bx}, {by}) channel {c}: {z:.2}σ, {:+.3} % of {r:.5}",
+                            100.0 * d / r
+                        );
+                    }
+                }
+            }
+        }
+    }
+    let o = Outcome {
+        pass_rate,
+        squared_over_predicted,
+        mean_sigma,
+        mean_bias,
+        worst_block,
+    };
+    eprintln!(
+        "{name}, {}, {} spp: {:.3} % pass, squared error / predicted {:.3}; image mean {:+.2}σ {:+.2}σ {:+.2}σ ({:+.3} % {:+.3} % {:+.3} %); worst 16×16 block {:.2}σ at ({}, {}) channel {}",
+        kind.name(),
+        RENDERS * spp as u64,
+        100.0 * o.pass_rate,
+        o.squared_over_predicted,
+        o.mean_sigma[0],
+        o.mean_sigma[1],
+        o.mean_sigma[2],
+        100.0 * o.mean_bias[0],
+        100.0 * o.mean_bias[1],
+        100.0 * o.mean_bias[2],
+        o.worst_block.0,
+        o.worst_block.1,
+        o.worst_block.2,
+        o.worst_block.3,
+    );
+    Some(o)
+}
+
+fn region_reference(r: &Reference, x0: usize, y0: usize, side: usize, c: usize) -> f64 {
+    let mut sum = 0.0;
+    for y in y0..y0 + side {
+        for x in x0..x0 + side {
+            sum += r.mean[y * SIZE + x][c];
+        }
+    }
+    sum / (side * side) as f64
+}
+
+/// The three tests, with what failed named.
+fn passes(name: &str, kind: IntegratorKind, spp: u32, tweak: impl Fn(&mut RenderSettings)) {
+    let Some(o) = compare(name, kind, spp, tweak) else {
+        return;
+    };
+    let what = format!("{name} by {}", kind.name());
+    assert!(
+        o.pass_rate >= 0.9975,
+        "{what}: only {:.3} % of pixel channels pass the z-test",
+        100.0 * o.pass_rate
+    );
+    assert!(
+        o.mean_sigma.iter().all(|z| z.abs() <= 5.0),
+        "{what}: the image mean is {:?}σ from the reference's ({:?} relative)",
+        o.mean_sigma,
+        o.mean_bias
+    );
+    assert!(
+        o.worst_block.0 <= 6.0,
+        "{what}: the 16×16 block ({}, {}) is {:.2}σ from the reference in channel {}",
+        o.worst_block.1,
+        o.worst_block.2,
+        o.worst_block.0,
+        o.worst_block.3
+    );
+}
+
+macro_rules! reference_tests {
+    ($($test:ident: $scene:literal, $kind:ident, $spp:literal;)*) => {$(
+        #[test]
+        #[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
+        fn $test() {
+            passes($scene, IntegratorKind::$kind, $spp, |_| {});
+        }
+    )*};
+}
+
+// Measured (December 2026; 16 renders, spp each as given; pass rate, image mean in σ, worst
+// block in σ). Passing, and tested here:
+//   path     delta 16: 99.91 %, −0.33σ, 3.2σ · env 16: 99.94 %, +0.96σ, 2.5σ ·
+//            mis 64: 99.96 %, +0.31σ, 5.1σ
+//   bdpt     specular 16: 99.78 %, −0.91σ, 3.0σ · rough 16: 99.99 %, 2.7σ · env 16:
+//            99.99 %, 2.6σ · delta 16: 99.99 %, +1.98σ, 2.8σ · lens 16: 99.80 %, −1.0σ,
+//            2.9σ · mis 64: 99.94 %, +0.83σ, 3.2σ
+//   sppm     env 16: 99.79 %, +2.78σ, 2.9σ
+// Not yet passing, and so not here (issue 46 keeps them open):
+//   path     specular 16: 96.5 % (128: 98.6 %), lens 16: 96.7 %, rough 64: 99.30 %: the
+//            caustics through glass are rare, heavy-tailed samples; at these counts most
+//            pixels' renders hold none, so their mean is low and their variance small. The
+//            image means agree (−0.19 %, 1.5σ; at 128 spp +0.003 %).
+//   light    delta 64: 99.70 %, rough 16: 99.40 % (glossy sphere and glass seen directly).
+//   sppm     specular, rough, lens: the block where the red wall meets the floor is
+//            9–13σ dark at 16 and 64 iterations (light gathered across the corner, SPPM's
+//            bias, shrinking with the radius); delta 64: image mean −5σ (−0.2 %).
+reference_tests! {
+    path_delta: "delta", Path, 16;
+    path_env: "env", Path, 16;
+    path_mis: "mis", Path, 64;
+    bdpt_specular: "specular", Bdpt, 16;
+    bdpt_rough: "rough", Bdpt, 16;
+    bdpt_mis: "mis", Bdpt, 64;
+    bdpt_env: "env", Bdpt, 16;
+    bdpt_delta: "delta", Bdpt, 16;
+    bdpt_lens: "lens", Bdpt, 16;
+    sppm_env: "env", Sppm, 16;
+}
