@@ -281,8 +281,11 @@ macro_rules! reference_tests {
 //            image means agree (−0.19 %, 1.5σ; at 128 spp +0.003 %).
 //   light    delta 64: 99.70 %, rough 16: 99.40 % (glossy sphere and glass seen directly).
 //   sppm     specular, rough, lens: the block where the red wall meets the floor is
-//            9–13σ dark at 16 and 64 iterations (light gathered across the corner, SPPM's
-//            bias, shrinking with the radius); delta 64: image mean −5σ (−0.2 %).
+//            9–13σ dark at 16 and 64 iterations: a gather disc that reaches past the
+//            floor's edge finds no floor photons there but is divided by its whole area
+//            (density estimation's boundary bias, which only the shrinking radius removes;
+//            leaving out photons on other surfaces by their normals made it 14σ); delta 64:
+//            image mean −5σ (−0.2 %).
 reference_tests! {
     path_delta: "delta", Path, 16;
     path_env: "env", Path, 16;
