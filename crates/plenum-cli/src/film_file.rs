@@ -4,7 +4,7 @@
 //! Layout, little-endian: the magic line `PLENUM-FILM 2\n`; the header's length (u64) and
 //! the header, JSON (the scene file, a hash of the scene, the settings, the command line, the
 //! film's size and sample range); the film, each list after its length as u64 (per pixel
-//! Σw·L, Σw and ΣL as i128, the sample count as u32, and Σ Y and Σ Y² as f64; a byte per
+//! Σw·L, Σw and ΣL as i128, Σ(w·L)² as f64, the sample count as u32, and Σ Y and Σ Y² as f64; a byte per
 //! pixel of passes done; the open flags of sampling by variance; the splat sums as i64;
 //! SPPM's statistics, after its iterations done (u32) and photons per iteration (u64): per
 //! pixel r, N, τ and L_d as f64); and last an FNV-1a hash of all that precedes it, so that a
@@ -70,13 +70,16 @@ pub fn encode(film: &RawFilm, p: &Provenance) -> Vec<u8> {
     })
     .to_string();
     let n = film.pixels.len();
-    let mut out = Vec::with_capacity(64 + header.len() + n * 132 + n * 2 + film.splats.len() * 24);
+    let mut out = Vec::with_capacity(64 + header.len() + n * 156 + n * 2 + film.splats.len() * 24);
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&(header.len() as u64).to_le_bytes());
     out.extend_from_slice(header.as_bytes());
     out.extend_from_slice(&(film.pixels.len() as u64).to_le_bytes());
     for px in &film.pixels {
         for v in px.weighted.iter().chain([&px.weight]).chain(&px.plain) {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        for v in &px.weighted_squared {
             out.extend_from_slice(&v.to_le_bytes());
         }
         out.extend_from_slice(&px.count.to_le_bytes());
@@ -215,16 +218,18 @@ pub fn decode(bytes: &[u8]) -> Result<(RawFilm, Provenance), String> {
     let sums = r.length("pixels", n, true)?;
     film.pixels.truncate(sums);
     for px in film.pixels.iter_mut() {
-        let b = r.take(7 * 16 + 4 + 16, "the pixels")?;
+        let b = r.take(7 * 16 + 3 * 8 + 4 + 16, "the pixels")?;
         let i128_at =
             |i: usize| i128::from_le_bytes(b[i * 16..i * 16 + 16].try_into().expect("16"));
+        let f64_at = |at: usize| f64::from_le_bytes(b[at..at + 8].try_into().expect("8"));
         *px = PixelSums {
             weighted: [i128_at(0), i128_at(1), i128_at(2)],
             weight: i128_at(3),
             plain: [i128_at(4), i128_at(5), i128_at(6)],
-            count: u32::from_le_bytes(b[112..116].try_into().expect("4")),
-            luminance: f64::from_le_bytes(b[116..124].try_into().expect("8")),
-            luminance_squared: f64::from_le_bytes(b[124..132].try_into().expect("8")),
+            weighted_squared: [f64_at(112), f64_at(120), f64_at(128)],
+            count: u32::from_le_bytes(b[136..140].try_into().expect("4")),
+            luminance: f64_at(140),
+            luminance_squared: f64_at(148),
         };
     }
     let stages = r.length("passes", sums, false)?;

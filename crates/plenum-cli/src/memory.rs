@@ -6,16 +6,16 @@
 use plenum_core::integrator::IntegratorKind;
 
 /// Bytes per pixel a render allocates, by what it keeps per pixel, measured as peak resident
-/// memory over 1024² pixels (December 2026: 190 bytes for Whitted's method, 260 for BDPT,
-/// 670 for SPPM) and rounded up by a quarter: the raw film's exact sums (145 bytes) and the
+/// memory over 1024² pixels (December 2026: 250 bytes for Whitted's method, 280 for BDPT,
+/// 670 for SPPM) and rounded up by a quarter: the raw film's sums (160 bytes) and the
 /// image resolved from it, splats in fixed point (light tracing, BDPT: the buffer and the
 /// film's copy), SPPM's visible points and its statistics (kept twice: the iteration's and
 /// the film's), adaptive sampling's open flags.
 pub fn bytes_per_pixel(kind: IntegratorKind, adaptive: bool, strategy_images: usize) -> u64 {
     let base = match kind {
         IntegratorKind::Sppm => 670,
-        IntegratorKind::Light | IntegratorKind::Bdpt => 260,
-        _ => 190,
+        IntegratorKind::Light | IntegratorKind::Bdpt => 280,
+        _ => 250,
     };
     let adaptive = if adaptive { 2 } else { 0 };
     // BDPT's strategy images: two films each (weighted and unweighted).

@@ -1303,3 +1303,49 @@ fn slurm_and_dask_renders_merge_to_the_bytes_of_one_render() {
         );
     }
 }
+
+/// `--aov variance` writes NAME.variance.EXT beside the output (positive where the image is
+/// noisy); it is refused, exit 2, where pixels are not their own samples' mean.
+#[test]
+fn the_variance_aov_is_written_beside_the_image() {
+    let tmp = temp_dir("aov");
+    let dir = tmp.path();
+    let args = cornell_args("16", "8");
+    let o = plenum()
+        .current_dir(dir)
+        .arg("render")
+        .args(&args)
+        .args(["--aov", "variance", "-o", "out.pfm"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v = plenum_image::read_float_image(&dir.join("out.variance.pfm")).unwrap();
+    assert_eq!((v.width, v.height), (16, 16));
+    assert!(v
+        .pixels
+        .iter()
+        .all(|p| p.iter().all(|c| *c >= 0.0 && c.is_finite())));
+    assert!(v.pixels.iter().any(|p| p[0] > 0.0));
+    for (extra, says) in [
+        (
+            &["--integrator", "bdpt"][..],
+            "not available with integrator `bdpt`",
+        ),
+        (
+            &["--integrator", "sppm"][..],
+            "not available with integrator `sppm`",
+        ),
+        (&["-o", "x.plf"][..], "writes an image"),
+    ] {
+        let o = plenum()
+            .current_dir(dir)
+            .arg("render")
+            .args(&args)
+            .args(["--aov", "variance"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
+    }
+}

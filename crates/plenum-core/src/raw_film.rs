@@ -41,6 +41,10 @@ pub struct PixelSums {
     pub weight: i128,
     /// Σ L per channel, in units of 2⁻³².
     pub plain: [i128; 3],
+    /// Σ (w·L)² per channel, for the variance of the pixel's value: in floating point (half
+    /// the memory of the exact sums), so a resumed or merged render's variance image may
+    /// differ from one render's in its last bits; its image does not.
+    pub weighted_squared: [f64; 3],
     pub count: u32,
     /// Σ Y and Σ Y² of the samples' luminance, for adaptive sampling, in the order the
     /// samples were taken (adaptive renders are continued, never split).
@@ -58,8 +62,10 @@ impl PixelSums {
 
     pub fn add(&mut self, c: Color, weight: f64) {
         for (i, v) in [c.r, c.g, c.b].into_iter().enumerate() {
-            self.weighted[i] += units(v * weight);
+            let wl = v * weight;
+            self.weighted[i] += units(wl);
             self.plain[i] += units(v);
+            self.weighted_squared[i] += wl * wl;
         }
         self.weight += units(weight);
         self.count += 1;
@@ -82,6 +88,25 @@ impl PixelSums {
         }
     }
 
+    /// The variance of [`value`](Self::value) as an estimate of the pixel's true value, per
+    /// channel, from its own samples: the sample variance of w·L over n, divided by the
+    /// mean weight squared (the ratio estimator's first-order variance; exact for filters
+    /// whose samples all weigh the same, the box among them). 0 below two samples.
+    pub fn variance(&self) -> Color {
+        let n = self.count as f64;
+        let mean_weight = value(self.weight) / n;
+        if self.count < 2 || mean_weight <= 0.0 {
+            return Color::BLACK;
+        }
+        let v = |c: usize| {
+            let sum = value(self.weighted[c]);
+            let squares = self.weighted_squared[c];
+            let sample_variance = ((squares - sum * sum / n) / (n - 1.0)).max(0.0);
+            sample_variance / n / (mean_weight * mean_weight)
+        };
+        Color::new(v(0), v(1), v(2))
+    }
+
     /// Whether the standard error of the luminance is at most `threshold` × max(mean, 0.05).
     pub fn converged(&self, threshold: f64) -> bool {
         let n = self.count as f64;
@@ -97,6 +122,7 @@ impl PixelSums {
         for i in 0..3 {
             self.weighted[i] += o.weighted[i];
             self.plain[i] += o.plain[i];
+            self.weighted_squared[i] += o.weighted_squared[i];
         }
         self.weight += o.weight;
         self.count += o.count;
@@ -257,6 +283,23 @@ impl RawFilm {
         image
     }
 
+    /// Each pixel's variance of its value, from its own samples (a Mitsuba `moment`-style
+    /// variance image, so that one render can be z-tested); `None` where the pixels' own
+    /// samples do not make the image: splats (light tracing, BDPT), SPPM's iterations, the
+    /// SPD corners.
+    pub fn variance_image(&self) -> Option<Film> {
+        if !self.splats.is_empty() || self.progressive.is_some() || self.corners {
+            return None;
+        }
+        let mut film = Film::new(self.width, self.height);
+        for (i, px) in self.pixels.iter().enumerate() {
+            let w = self.width as usize;
+            film.set((i % w) as u32, (i / w) as u32, px.variance());
+        }
+        film.resolve(1.0);
+        Some(film)
+    }
+
     /// The sum of renders of consecutive sample ranges of one image, each complete: the
     /// film of their whole range. Parts are added in the order of their ranges.
     pub fn merge(mut parts: Vec<RawFilm>) -> Result<RawFilm, String> {
@@ -377,6 +420,34 @@ mod tests {
             .iter()
             .fold((0.0, 0.0), |(sw, swl), &(c, w)| (sw + w, swl + w * c.g));
         assert!((forward.value().g - swl / sw).abs() < 1e-9);
+    }
+
+    /// With equal weights the variance is the samples' sample variance over n, exactly
+    /// (to the 2⁻³² rounding); with other constant weights the same; below two samples 0.
+    #[test]
+    fn variance_of_the_mean_from_the_samples() {
+        let values = [0.5, 1.5, 4.0, 2.0, 0.25];
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let expected = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n;
+        for weight in [1.0, 0.37] {
+            let mut px = PixelSums::default();
+            for v in values {
+                px.add(Color::new(v, 2.0 * v, 0.0), weight);
+            }
+            let var = px.variance();
+            assert!(
+                (var.r - expected).abs() < 1e-8,
+                "{weight}: {} for {expected}",
+                var.r
+            );
+            assert!((var.g - 4.0 * expected).abs() < 1e-8);
+            assert_eq!(var.b, 0.0);
+        }
+        assert_eq!(
+            PixelSums::single(Color::new(3.0, 3.0, 3.0)).variance(),
+            Color::BLACK
+        );
     }
 
     #[test]
