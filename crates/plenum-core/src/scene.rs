@@ -177,10 +177,12 @@ pub struct Scene {
     needs_uv: Vec<bool>,
     /// I_a: the sum of the scene's ambient lights.
     pub ambient: Color,
-    /// Radiance of rays that hit nothing.
+    /// Radiance of rays that hit nothing: Whitted's model reads it here; the physically based
+    /// methods see it as the light `background_light`.
     pub background: Color,
-    /// The background as a spectrum, for the physically based integrators.
-    background_spectrum: SpectrumValue,
+    /// The background as a light (a uniform infinite light, the last of `lights`), where it
+    /// is not black.
+    pub background_light: Option<u32>,
     /// Per light: its emission as a spectrum (an RGB light's uplifted as an illuminant).
     light_spectra: Vec<SpectrumValue>,
     /// Per primitive: the area light it is the surface of.
@@ -458,16 +460,6 @@ impl Scene {
                 .materials
                 .iter()
                 .all(|m| m.phong().is_none_or(|p| p.emissive.is_black()))
-    }
-
-    /// The background's radiance at the sample's wavelengths.
-    #[inline]
-    pub fn background_spectrum(&self, wl: &SampledWavelengths) -> SampledSpectrum {
-        if self.background.is_black() {
-            SampledSpectrum::ZERO
-        } else {
-            self.background_spectrum.sample(wl)
-        }
     }
 
     /// `path` for a scene whose objects are all of physically based materials (emitters that
@@ -809,6 +801,15 @@ impl SceneBuilder {
 
     /// Builds the scene with `kind` structures, over its primitives and inside its meshes.
     pub fn build_with(mut self, kind: AccelKind) -> Scene {
+        // Under the physically based methods the background is a light like any other: a
+        // uniform infinite light (Mitsuba's `constant` emitter), sampled for direct light,
+        // emitting light paths and photons, and seen (with MIS) by rays that leave the
+        // scene. Whitted's model reads `background` itself, and no infinite light.
+        let background_light = (!self.background.is_black()).then(|| {
+            let radiance = self.background;
+            self.add_light("background", Light::Infinite { radiance });
+            self.lights.len() as u32 - 1
+        });
         // An opaque polyhedron is never entered, so its back faces can be culled.
         for p in &mut self.primitives {
             if let Shape::Polyhedron(poly) = &mut p.shape {
@@ -880,7 +881,7 @@ impl SceneBuilder {
         }
         let mut scene = Scene {
             one_sided,
-            background_spectrum: SpectrumValue::from_rgb(self.background, SpectrumKind::Illuminant),
+            background_light,
             light_spectra,
             primitive_lights,
             infinite_lights,

@@ -172,6 +172,10 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
         );
     }
     for (i, (light, name)) in scene.lights.iter().zip(&scene.light_names).enumerate() {
+        // The background is written as `background`, not as a light.
+        if Some(i as u32) == scene.background_light {
+            continue;
+        }
         if written_with_object(scene, i) {
             // Written as its object, with `emission`.
             continue;

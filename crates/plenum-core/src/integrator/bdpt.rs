@@ -277,13 +277,10 @@ impl<'a> BidirectionalPathTracer<'a> {
         record_subpath(&mut tree, light_path, RayKind::Light, &wl);
 
         let mut l = SampledSpectrum::ZERO;
-        // Emission no light stands for: the background and Phong k_e, by s = 0 alone.
-        for v in camera_path.iter().skip(1) {
-            if v.infinite {
-                l += v.beta * self.scene.background_spectrum(&wl);
-            } else {
-                l += v.beta * v.ke;
-            }
+        // Emission no light stands for, Phong k_e, by s = 0 alone (the background is a
+        // light at infinity, found by every strategy).
+        for v in camera_path.iter().skip(1).filter(|v| !v.infinite) {
+            l += v.beta * v.ke;
         }
         let max_vertices = self.max_depth as usize + 3;
         for t in 1..=camera_path.len() {

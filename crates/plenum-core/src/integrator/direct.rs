@@ -165,7 +165,7 @@ pub(super) fn bsdf_sample_ld(
     let ray = Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(time);
     let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
         let d = bs.wi.normalized();
-        return beta * (scene.background_spectrum(wl) + infinite_mis(scene, d, wl, pdf_bsdf, 1.0));
+        return beta * infinite_mis(scene, d, wl, pdf_bsdf, 1.0);
     };
     match scene.light_of(prim) {
         Some(light) => {

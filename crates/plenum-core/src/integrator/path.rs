@@ -101,8 +101,7 @@ impl<'a> PathTracer<'a> {
             });
             let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
                 let d = ray.direction.normalized();
-                let le = scene.background_spectrum(wl)
-                    + direct::infinite_mis(scene, d, wl, pdf_bsdf, 1.0);
+                let le = direct::infinite_mis(scene, d, wl, pdf_bsdf, 1.0);
                 l += beta * le;
                 record(&mut tree, node, |n| {
                     n.stops.push(Stop::Miss);

@@ -164,15 +164,15 @@ pub(super) fn emitted(
     SampledSpectrum::ZERO
 }
 
-/// Radiance from infinity along `d`: the background, and the lights at infinity where no
-/// other strategy finds them (`lights`: the ray came by specular bounces only).
+/// Radiance from infinity along `d`: the lights at infinity (the background among them)
+/// where no other strategy finds them (`lights`: the ray came by specular bounces only).
 pub(super) fn escaped(
     scene: &Scene,
     d: Vec3,
     wl: &SampledWavelengths,
     lights: bool,
 ) -> SampledSpectrum {
-    let mut le = scene.background_spectrum(wl);
+    let mut le = SampledSpectrum::ZERO;
     if lights {
         for &i in &scene.infinite_lights {
             le += scene.radiance_from_infinity(i, d, wl);
