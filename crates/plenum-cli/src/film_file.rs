@@ -212,11 +212,11 @@ pub fn decode(bytes: &[u8]) -> Result<(RawFilm, Provenance), String> {
         .checked_mul(height as usize)
         .filter(|&n| n <= bytes.len())
         .ok_or("its size does not match its length")?;
-    let mut film = RawFilm::new(width, height, corners, samples);
+    let mut film = RawFilm::empty(width, height, corners, samples);
     film.spp = number("spp")? as u32;
     // SPPM's films hold no per-sample sums: its lists are empty.
     let sums = r.length("pixels", n, true)?;
-    film.pixels.truncate(sums);
+    film.pixels = vec![PixelSums::default(); sums];
     for px in film.pixels.iter_mut() {
         let b = r.take(7 * 16 + 3 * 8 + 4 + 16, "the pixels")?;
         let i128_at =

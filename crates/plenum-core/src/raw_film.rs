@@ -204,13 +204,22 @@ impl RawFilm {
     pub fn new(width: u32, height: u32, corners: bool, samples: Range<u32>) -> RawFilm {
         let n = width as usize * height as usize;
         RawFilm {
+            pixels: vec![PixelSums::default(); n],
+            stages: vec![0; n],
+            ..RawFilm::empty(width, height, corners, samples)
+        }
+    }
+
+    /// A film of that size holding no pixels yet, for a reader to fill.
+    pub fn empty(width: u32, height: u32, corners: bool, samples: Range<u32>) -> RawFilm {
+        RawFilm {
             width,
             height,
             corners,
             spp: samples.end,
             samples,
-            pixels: vec![PixelSums::default(); n],
-            stages: vec![0; n],
+            pixels: Vec::new(),
+            stages: Vec::new(),
             open: Vec::new(),
             splats: Vec::new(),
             progressive: None,
@@ -220,14 +229,12 @@ impl RawFilm {
     /// An empty SPPM film of `iterations` iterations, `photons` photon paths each.
     pub fn progressive(width: u32, height: u32, iterations: u32, photons: u64) -> RawFilm {
         RawFilm {
-            pixels: Vec::new(),
-            stages: Vec::new(),
             progressive: Some(Progressive {
                 iterations: 0,
                 photons_per_iteration: photons,
                 pixels: vec![PhotonStatistics::default(); width as usize * height as usize],
             }),
-            ..RawFilm::new(width, height, false, 0..iterations)
+            ..RawFilm::empty(width, height, false, 0..iterations)
         }
     }
 
