@@ -24,7 +24,12 @@ pub struct SceneError {
 impl SceneError {
     /// An error at a byte range of `text`.
     pub fn at(path: &Path, text: &str, span: Range<usize>, message: impl Into<String>) -> Self {
-        let start = span.start.min(text.len());
+        // A span from another layer (an XML parser's position) may fall inside a
+        // character: widen it to whole characters.
+        let mut start = span.start.min(text.len());
+        while !text.is_char_boundary(start) {
+            start -= 1;
+        }
         let line_start = text[..start].rfind('\n').map_or(0, |i| i + 1);
         let line_end = text[start..].find('\n').map_or(text.len(), |i| start + i);
         let source_line = text[line_start..line_end]
@@ -32,7 +37,10 @@ impl SceneError {
             .to_string();
         let line = text[..start].matches('\n').count() + 1;
         let column = text[line_start..start].chars().count() + 1;
-        let end = span.end.clamp(start, line_end);
+        let mut end = span.end.clamp(start, line_end);
+        while !text.is_char_boundary(end) {
+            end += 1;
+        }
         let width = text[start..end].chars().count().max(1);
         SceneError {
             path: path.to_path_buf(),
@@ -133,6 +141,13 @@ fn edit_distance(a: &str, b: &str) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_span_inside_a_character_covers_the_character() {
+        // "é" is bytes 1..3: a span from byte 2 points at it.
+        let e = SceneError::at(Path::new("f"), "aéb", 2..3, "m");
+        assert_eq!((e.line, e.column, e.width), (1, 2, 1));
+    }
 
     #[test]
     fn location_and_caret() {

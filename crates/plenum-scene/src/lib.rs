@@ -3,6 +3,7 @@
 
 pub mod diagnostics;
 mod limits;
+mod mitsuba;
 mod model;
 mod mtl;
 mod native;
@@ -106,11 +107,11 @@ pub fn load_mesh(path: &Path) -> Result<plenum_core::geometry::TriangleMesh, Sce
 }
 
 /// The extensions of the scene files Plenum reads, by reader.
-pub const SCENE_EXTENSIONS: [&str; 5] = ["toml", "nff", "ray", "obj", "ply"];
+pub const SCENE_EXTENSIONS: [&str; 6] = ["toml", "nff", "ray", "obj", "ply", "xml"];
 
 /// Reads a scene file, choosing the format by extension: `.toml` (the native format), `.nff`
 /// (Haines' Neutral File Format), `.ray` (the course ray tracer's format), `.obj` and `.ply`
-/// (a mesh, framed by a default camera and lights); any other is refused. Relative paths
+/// (a mesh, framed by a default camera and lights), `.xml` (Mitsuba 3); any other is refused. Relative paths
 /// inside are resolved against the file's folder.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
     let extension = path
@@ -126,7 +127,7 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
         };
         return Err(SceneError::file(
             path,
-            format!("not a scene file Plenum reads: {found}; the formats are .toml (native), .nff, .ray, .obj and .ply"),
+            format!("not a scene file Plenum reads: {found}; the formats are .toml (native), .nff, .ray, .obj, .ply and .xml (Mitsuba 3)"),
         ));
     }
     let bytes = std::fs::read(path)
@@ -151,6 +152,14 @@ pub fn read_scene(path: &Path, extension: &str, bytes: Vec<u8>) -> Result<Loaded
                 scene: builder.build(),
                 defaults,
                 warnings: Vec::new(),
+            }
+        }
+        "xml" => {
+            let (builder, defaults, warnings) = mitsuba::parse(path, text)?;
+            LoadedScene {
+                scene: builder.build(),
+                defaults,
+                warnings,
             }
         }
         "ray" => {

@@ -752,6 +752,7 @@ impl<'s> Reader<'s> {
                         "file",
                         "layout",
                         "up",
+                        "axes",
                     ],
                 )?;
                 if let Some(file) = f.get("file") {
@@ -824,9 +825,38 @@ impl<'s> Reader<'s> {
                 }
             },
         };
-        let up = f.direction("up", Some(Vec3::Y))?.normalized();
         let scale = f.non_negative_or("intensity", 1.0)?;
-        let frame = plenum_core::sampling::Frame::from_z(up);
+        let frame = match f.get("axes") {
+            None => {
+                let up = f.direction("up", Some(Vec3::Y))?.normalized();
+                plenum_core::sampling::Frame::from_z(up)
+            }
+            Some(a) => {
+                if let Some(u) = f.get("up") {
+                    return Err(self
+                        .src
+                        .error(u.span(), "give either `up` or `axes`, not both"));
+                }
+                let rows = self.points(a)?;
+                let unit = |v: Vec3| (v.length() - 1.0).abs() < 1e-6;
+                let ok = rows.len() == 3
+                    && rows.iter().all(|v| unit(*v))
+                    && rows[0].dot(rows[1]).abs() < 1e-6
+                    && rows[1].dot(rows[2]).abs() < 1e-6
+                    && rows[0].dot(rows[2]).abs() < 1e-6;
+                if !ok {
+                    return Err(self.src.error(
+                        a.span(),
+                        "expected three orthonormal axes [[x], [y], [z]] (z the pole, φ from x toward y)",
+                    ));
+                }
+                plenum_core::sampling::Frame {
+                    x: rows[0],
+                    y: rows[1],
+                    z: rows[2],
+                }
+            }
+        };
         let map = EnvironmentMap::new(
             image.width as usize,
             image.height as usize,

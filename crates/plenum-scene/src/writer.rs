@@ -226,6 +226,7 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                 );
             }
             Light::Environment { map, .. } => {
+                let frame = map.map.frame();
                 let layout = match map.map.layout() {
                     plenum_core::environment::EnvironmentLayout::LatLong => "latlong",
                     plenum_core::environment::EnvironmentLayout::LatLongPoles => "latlong-poles",
@@ -233,9 +234,11 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                 };
                 let _ = writeln!(
                     w,
-                    "type = \"infinite\"\nfile = {}\nlayout = \"{layout}\"\nup = {}\nintensity = {:?}\n",
+                    "type = \"infinite\"\nfile = {}\nlayout = \"{layout}\"\naxes = [{}, {}, {}]\nintensity = {:?}\n",
                     quote(&map.file),
-                    vec(map.map.frame().z),
+                    vec(frame.x),
+                    vec(frame.y),
+                    vec(frame.z),
                     map.scale
                 );
             }

@@ -67,3 +67,96 @@ fn ply_records() {
             read("ply", &bytes);
         });
 }
+
+#[test]
+fn xml() {
+    bolero::check!().for_each(|bytes: &[u8]| read("xml", bytes));
+}
+
+/// Mitsuba scenes of random elements, nested at random but well formed: parameters,
+/// references (forward, unknown, to themselves), substitutions and transforms reach the
+/// plugin layer.
+#[test]
+fn xml_elements() {
+    // Containers: opened, and closed later by a pop or at the end.
+    const OPEN: &[(&str, &str)] = &[
+        ("<shape type=\"sphere\">", "</shape>"),
+        ("<shape type=\"rectangle\" id=\"r\">", "</shape>"),
+        ("<shape type=\"cylinder\">", "</shape>"),
+        (
+            "<shape type=\"obj\"><string name=\"filename\" value=\"m.obj\"/>",
+            "</shape>",
+        ),
+        ("<bsdf type=\"diffuse\" id=\"a\">", "</bsdf>"),
+        ("<bsdf type=\"twosided\" id=\"t\">", "</bsdf>"),
+        ("<bsdf type=\"blendbsdf\" id=\"b\">", "</bsdf>"),
+        ("<bsdf type=\"roughconductor\">", "</bsdf>"),
+        ("<bsdf type=\"plastic\">", "</bsdf>"),
+        ("<emitter type=\"area\">", "</emitter>"),
+        ("<emitter type=\"point\">", "</emitter>"),
+        ("<emitter type=\"spot\">", "</emitter>"),
+        (
+            "<emitter type=\"envmap\"><string name=\"filename\" value=\"e.exr\"/>",
+            "</emitter>",
+        ),
+        ("<sensor type=\"perspective\">", "</sensor>"),
+        (
+            "<sensor type=\"thinlens\"><float name=\"aperture_radius\" value=\"V\"/>",
+            "</sensor>",
+        ),
+        ("<film type=\"hdrfilm\">", "</film>"),
+        ("<integrator type=\"path\">", "</integrator>"),
+        (
+            "<texture type=\"checkerboard\" name=\"reflectance\">",
+            "</texture>",
+        ),
+    ];
+    const LEAF: &[&str] = &[
+        "<ref id=\"a\"/>",
+        "<ref id=\"b\"/>",
+        "<ref id=\"t\"/>",
+        "<ref name=\"bsdf\" id=\"x\"/>",
+        "<float name=\"radius\" value=\"V\"/>",
+        "<float name=\"alpha\" value=\"V\"/>",
+        "<float name=\"weight\" value=\"V\"/>",
+        "<float name=\"fov\" value=\"$f\"/>",
+        "<default name=\"f\" value=\"V\"/>",
+        "<integer name=\"width\" value=\"V\"/>",
+        "<integer name=\"max_depth\" value=\"V\"/>",
+        "<rgb name=\"reflectance\" value=\"V V V\"/>",
+        "<rgb name=\"radiance\" value=\"V\"/>",
+        "<spectrum name=\"radiance\" value=\"400:V, 500:V\"/>",
+        "<point name=\"center\" x=\"V\" y=\"V\" z=\"V\"/>",
+        "<point name=\"p1\" value=\"V\"/>",
+        "<transform name=\"to_world\"><scale value=\"V\"/><rotate y=\"1\" angle=\"V\"/></transform>",
+        "<transform name=\"to_world\"><lookat origin=\"0 0 V\" target=\"0 0 0\" up=\"0 1 0\"/></transform>",
+        "<transform name=\"to_world\"><matrix value=\"V 0 0 0 0 V 0 0 0 0 V 0 0 0 0 1\"/></transform>",
+        "<rfilter type=\"gaussian\"/>",
+        "<sampler type=\"stratified\"><integer name=\"sample_count\" value=\"V\"/></sampler>",
+        "<include filename=\"other.xml\"/>",
+    ];
+    bolero::check!()
+        .with_type::<Vec<(u8, i16)>>()
+        .for_each(|items| {
+            let mut text = String::from("<scene version=\"3.0.0\">");
+            let mut open = Vec::new();
+            for (piece, v) in items {
+                let value = format!("{}", *v as f64 / 100.0);
+                let i = *piece as usize;
+                match i % 3 {
+                    0 => {
+                        let (start, end) = OPEN[i / 3 % OPEN.len()];
+                        text.push_str(&start.replace('V', &value));
+                        open.push(end);
+                    }
+                    1 => text.push_str(open.pop().unwrap_or("")),
+                    _ => text.push_str(&LEAF[i / 3 % LEAF.len()].replace('V', &value)),
+                }
+            }
+            while let Some(end) = open.pop() {
+                text.push_str(end);
+            }
+            text.push_str("</scene>");
+            read("xml", text.as_bytes());
+        });
+}

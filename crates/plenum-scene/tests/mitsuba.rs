@@ -1,0 +1,428 @@
+//! Mitsuba 3's XML scenes (`plenum render scene.xml`): the parser's semantics, the plugins'
+//! mapping, handedness, located errors and warnings, and the six feature scenes of
+//! ../shared/data/references/features read as their hand-made native ports.
+
+mod common;
+
+use common::integrators::{draw, path_settings};
+use plenum_core::integrator::ColorMode;
+use plenum_scene::{load_scene, to_toml, LoadedScene, SceneError};
+use std::path::{Path, PathBuf};
+use toml::{Table, Value};
+
+/// Writes `files` (name, text) into a fresh folder and loads the first.
+fn load_files(files: &[(&str, &str)]) -> Result<LoadedScene, SceneError> {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    load_scene(&dir.path().join(files[0].0))
+}
+
+fn load(text: &str) -> LoadedScene {
+    load_files(&[("scene.xml", text)]).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn error(text: &str) -> SceneError {
+    match load_files(&[("scene.xml", text)]) {
+        Ok(_) => panic!("expected an error"),
+        Err(e) => e,
+    }
+}
+
+/// The scene as the native format writes it, parsed.
+fn native(l: &LoadedScene) -> Table {
+    to_toml(&l.scene, &l.defaults).parse().unwrap()
+}
+
+fn scene(body: &str) -> String {
+    format!("<scene version=\"3.0.0\">\n{body}\n</scene>\n")
+}
+
+/// A scene with a camera and a sky, so that only what is tested is warned about.
+fn lit(body: &str) -> String {
+    scene(&format!(
+        "<sensor type=\"perspective\"/><emitter type=\"constant\"/>\n{body}"
+    ))
+}
+
+/// The material table of object `i`.
+fn material_of<'a>(t: &'a Table, i: usize) -> &'a Table {
+    let name = t["objects"][i]["material"].as_str().unwrap();
+    t["materials"][name].as_table().unwrap()
+}
+
+fn number(v: &Value) -> f64 {
+    v.as_float()
+        .or_else(|| v.as_integer().map(|i| i as f64))
+        .unwrap()
+}
+
+/// Whether two written scenes agree: numbers within 1e-6 (relative), files by their
+/// canonical path, each object's material by value (the names may differ, and a port may
+/// hold materials nothing uses).
+fn same(a: &Value, b: &Value, at: &str) -> Result<(), String> {
+    match (a, b) {
+        (Value::Table(x), Value::Table(y)) => {
+            let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+            for k in keys {
+                match (x.get(k), y.get(k)) {
+                    (Some(p), Some(q)) => same(p, q, &format!("{at}.{k}"))?,
+                    _ => return Err(format!("{at}.{k}: in one scene only")),
+                }
+            }
+            Ok(())
+        }
+        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => {
+            for (i, (p, q)) in x.iter().zip(y).enumerate() {
+                same(p, q, &format!("{at}[{i}]"))?;
+            }
+            Ok(())
+        }
+        (Value::String(x), Value::String(y)) => {
+            let canonical = |s: &str| std::fs::canonicalize(s).ok();
+            if x == y || (canonical(x).is_some() && canonical(x) == canonical(y)) {
+                Ok(())
+            } else {
+                Err(format!("{at}: {x:?} and {y:?}"))
+            }
+        }
+        (Value::Integer(_) | Value::Float(_), Value::Integer(_) | Value::Float(_)) => {
+            let (p, q) = (number(a), number(b));
+            if (p - q).abs() <= 1e-6 * p.abs().max(q.abs()).max(1.0) {
+                Ok(())
+            } else {
+                Err(format!("{at}: {p} and {q}"))
+            }
+        }
+        _ if a == b => Ok(()),
+        _ => Err(format!("{at}: {a} and {b}")),
+    }
+}
+
+/// `t` with each object's material written into it and the material list dropped.
+fn by_value(mut t: Table) -> Table {
+    let materials = t.remove("materials").unwrap();
+    if let Some(Value::Array(objects)) = t.get_mut("objects") {
+        for o in objects {
+            let o = o.as_table_mut().unwrap();
+            let m = materials[o["material"].as_str().unwrap()].clone();
+            o.insert("material".into(), m);
+        }
+    }
+    t
+}
+
+#[test]
+fn the_feature_scenes_import_as_their_native_ports() {
+    let features =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/references/features");
+    if !features.is_dir() {
+        common::missing("../shared/data/references/features");
+        return;
+    }
+    for name in ["specular", "rough", "mis", "env", "delta", "lens"] {
+        let xml =
+            load_scene(&features.join(name).join("scene.xml")).unwrap_or_else(|e| panic!("{e}"));
+        let port = load_scene(
+            &Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("tests/references")
+                .join(format!("{name}.toml")),
+        )
+        .unwrap();
+        let (a, b) = (by_value(native(&xml)), by_value(native(&port)));
+        if let Err(e) = same(&Value::Table(a), &Value::Table(b), name) {
+            panic!("{name}: the XML and its port differ at {e}");
+        }
+        // Every property of these scenes has a counterpart: nothing is ignored.
+        assert!(xml.warnings.is_empty(), "{name}: {:?}", xml.warnings);
+    }
+}
+
+#[test]
+fn defaults_substitutions_includes_and_forward_references() {
+    let main = scene(
+        r#"<default name="radius" value="0.25"/>
+        <default name="kind" value="diffuse"/>
+        <shape type="sphere" id="ball">
+            <float name="radius" value="$radius"/>
+            <point name="center" value="1, 2, 3"/>
+            <ref id="paint"/>
+        </shape>
+        <bsdf type="$kind" id="paint">
+            <rgb name="reflectance" value="0.1 0.2 0.3"/>
+        </bsdf>
+        <include filename="more.xml"/>"#,
+    );
+    let more = scene(
+        r#"<shape type="disk" id="floor"><bsdf type="twosided"><bsdf type="diffuse"/></bsdf></shape>"#,
+    );
+    let l =
+        load_files(&[("main.xml", &main), ("more.xml", &more)]).unwrap_or_else(|e| panic!("{e}"));
+    let t = native(&l);
+    let objects = t["objects"].as_array().unwrap();
+    assert_eq!(objects.len(), 2);
+    assert_eq!(objects[0]["name"].as_str(), Some("ball"));
+    assert_eq!(number(&objects[0]["radius"]), 0.25);
+    let center: Vec<f64> = objects[0]["center"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(number)
+        .collect();
+    assert_eq!(center, [1.0, 2.0, 3.0]);
+    let paint = material_of(&t, 0);
+    assert_eq!(paint["type"].as_str(), Some("diffuse"));
+    let r: Vec<f64> = paint["reflectance"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(number)
+        .collect();
+    assert_eq!(r, [0.1, 0.2, 0.3]);
+    // One-sided, as Mitsuba's BSDFs are; the included floor is wrapped in twosided.
+    assert_eq!(paint["two_sided"].as_bool(), Some(false));
+    assert_eq!(objects[1]["name"].as_str(), Some("floor"));
+    assert_ne!(
+        material_of(&t, 1).get("two_sided").and_then(Value::as_bool),
+        Some(false)
+    );
+}
+
+#[test]
+fn transforms_compose_in_the_order_written() {
+    // Translate, then scale by 2: the unit rectangle's corner (1, 1, 0) lands at (4, 2, 0).
+    let l = load(&scene(
+        r#"<shape type="rectangle"><transform name="to_world">
+            <translate x="1"/><scale value="2"/>
+        </transform></shape>"#,
+    ));
+    let b = l.scene.bounds();
+    assert!(
+        (b.max.x - 4.0).abs() < 1e-12 && (b.max.y - 2.0).abs() < 1e-12,
+        "{b:?}"
+    );
+    assert!(
+        (b.min.x - 0.0).abs() < 1e-12 && (b.min.y + 2.0).abs() < 1e-12,
+        "{b:?}"
+    );
+    // Rotations are right-handed: +x turned 90° about +z is +y.
+    let l = load(&scene(
+        r#"<shape type="sphere"><point name="center" x="1" y="0" z="0"/><float name="radius" value="0.1"/>
+            <transform name="to_world"><rotate z="1" angle="90"/></transform></shape>"#,
+    ));
+    let b = l.scene.bounds();
+    let c = (b.min + b.max) * 0.5;
+    assert!(c.x.abs() < 1e-9 && (c.y - 1.0).abs() < 1e-9, "{c:?}");
+}
+
+#[test]
+fn the_camera_keeps_mitsubas_handedness() {
+    // Mitsuba's look-at frame has +x to the left of the view: looking along +z with +y up,
+    // a lamp at x = +1 appears in the image's left half, one at y = +1 in its top half.
+    let picture = |x: f64, y: f64| {
+        let l = load(&scene(&format!(
+            r#"<sensor type="perspective">
+                <float name="fov" value="60"/>
+                <transform name="to_world"><lookat origin="0 0 0" target="0 0 1" up="0 1 0"/></transform>
+                <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/></film>
+            </sensor>
+            <shape type="sphere"><point name="center" x="{x}" y="{y}" z="4"/><float name="radius" value="0.5"/>
+                <emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>"#
+        )));
+        let image = draw(&l, &path_settings(&l, 1, ColorMode::Rgb, 7));
+        let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+        for (i, p) in image.iter().enumerate() {
+            if p[0] > 0.5 {
+                sx += (i % 32) as f64;
+                sy += (i / 32) as f64;
+                n += 1.0;
+            }
+        }
+        assert!(n > 0.0, "the lamp is seen");
+        (sx / n, sy / n)
+    };
+    let (x, y) = picture(1.0, 0.0);
+    assert!(
+        x < 12.0 && (y - 15.5).abs() < 2.0,
+        "a lamp at +x lands at ({x}, {y})"
+    );
+    let (x, y) = picture(0.0, 1.0);
+    assert!(
+        (x - 15.5).abs() < 2.0 && y < 12.0,
+        "a lamp at +y lands at ({x}, {y})"
+    );
+}
+
+#[test]
+fn integrators_films_and_samplers_become_the_render_defaults() {
+    let l = load(&scene(
+        r#"<integrator type="path"><integer name="max_depth" value="6"/><integer name="rr_depth" value="4"/></integrator>
+        <sensor type="thinlens">
+            <float name="fov" value="30"/><string name="fov_axis" value="x"/>
+            <float name="aperture_radius" value="0.1"/><float name="focus_distance" value="5"/>
+            <sampler type="stratified"><integer name="sample_count" value="64"/></sampler>
+            <film type="hdrfilm"><integer name="width" value="200"/><integer name="height" value="100"/>
+                <rfilter type="tent"/></film>
+        </sensor>"#,
+    ));
+    let d = &l.defaults;
+    assert_eq!((d.width, d.height, d.spp), (200, 100, 64));
+    assert_eq!((d.max_depth, d.rr_depth), (4, 2), "Mitsuba's depths less 2");
+    assert_eq!(d.sampler, plenum_core::sampling::SamplerKind::Jittered);
+    assert_eq!(d.filter, plenum_core::sampling::FilterKind::Tent);
+    let t = native(&l);
+    let camera = t["camera"].as_table().unwrap();
+    assert_eq!(number(&camera["aperture"]), 0.1);
+    assert_eq!(number(&camera["focus_distance"]), 5.0);
+    // 30° across a 2:1 image: tan(v/2) = tan(15°)/2.
+    let v = number(&camera["fov"]);
+    assert!(((0.5 * v).to_radians().tan() - 15f64.to_radians().tan() / 2.0).abs() < 1e-9);
+    // No film: Mitsuba's 768 × 576 and Gaussian filter; `direct` is Plenum's depth 0.
+    let l = load(&scene(
+        r#"<integrator type="direct"/><sensor type="perspective"/>"#,
+    ));
+    assert_eq!(
+        (l.defaults.width, l.defaults.height, l.defaults.max_depth),
+        (768, 576, 0)
+    );
+}
+
+#[test]
+fn materials_map_with_mitsubas_names_and_defaults() {
+    let l = load(&scene(
+        r#"<shape type="sphere"><bsdf type="dielectric"><string name="int_ior" value="water"/></bsdf></shape>
+        <shape type="sphere"><bsdf type="conductor"><string name="material" value="Au"/></bsdf></shape>
+        <shape type="sphere"><bsdf type="conductor"/></shape>
+        <shape type="sphere"><bsdf type="roughconductor"><string name="distribution" value="ggx"/>
+            <float name="alpha_u" value="0.3"/><float name="alpha_v" value="0.05"/></bsdf></shape>
+        <shape type="sphere"><bsdf type="blendbsdf"><float name="weight" value="0.25"/>
+            <bsdf type="diffuse"/><bsdf type="conductor"/></bsdf></shape>
+        <shape type="sphere"/>"#,
+    ));
+    let t = native(&l);
+    let water = material_of(&t, 0);
+    assert!((number(&water["eta"]) - 1.3330 / 1.00028).abs() < 1e-12);
+    // Gold's measured η and k, as the native format's `metal = "Au"` reads them.
+    let gold = common::integrators::scene(
+        "[materials.m]\ntype = \"conductor\"\nmetal = \"Au\"\n[[objects]]\ntype = \"sphere\"\nradius = 1\nmaterial = \"m\"\n",
+    );
+    let gold = native(&gold);
+    let (a, b) = (material_of(&t, 1), material_of(&gold, 0));
+    same(&a["eta"], &b["eta"], "eta").unwrap();
+    same(&a["k"], &b["k"], "k").unwrap();
+    // Mitsuba's default conductor is a perfect mirror.
+    let r: Vec<f64> = material_of(&t, 2)["reflectance"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(number)
+        .collect();
+    assert_eq!(r, [1.0, 1.0, 1.0]);
+    let rough: Vec<f64> = material_of(&t, 3)["roughness"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(number)
+        .collect();
+    assert!(
+        (rough[0] - 0.3).abs() < 1e-12 && (rough[1] - 0.05).abs() < 1e-12,
+        "{rough:?}"
+    );
+    assert_eq!(material_of(&t, 3)["remap_roughness"].as_bool(), Some(false));
+    let mix = material_of(&t, 4);
+    assert_eq!(mix["type"].as_str(), Some("mix"));
+    assert_eq!(number(&mix["amount"]), 0.25);
+    // A shape without a BSDF: diffuse 0.5, one-sided.
+    let bare = material_of(&t, 5);
+    assert_eq!(bare["type"].as_str(), Some("diffuse"));
+    assert_eq!(bare["two_sided"].as_bool(), Some(false));
+}
+
+#[test]
+fn version_0_6_names_are_upgraded() {
+    let l = load(
+        r#"<scene version="0.6.0"><sensor type="perspective"/><emitter type="constant"/>
+            <shape type="sphere"><bsdf type="dielectric"><float name="intIOR" value="1.33"/><float name="extIOR" value="1"/></bsdf></shape>
+            <shape type="sphere"><bsdf type="diffuse"><rgb name="diffuseReflectance" value="0.2"/></bsdf></shape>
+        </scene>"#,
+    );
+    let t = native(&l);
+    assert!((number(&material_of(&t, 0)["eta"]) - 1.33).abs() < 1e-12);
+    let r: Vec<f64> = material_of(&t, 1)["reflectance"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(number)
+        .collect();
+    assert_eq!(r, [0.2, 0.2, 0.2]);
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+}
+
+#[test]
+fn errors_name_the_line_and_column() {
+    let e = error(&scene(
+        r#"<shape type="sphere"><float name="radius" value="$r"/></shape>"#,
+    ));
+    assert_eq!((e.line, e.column), (2, 50), "{e}");
+    assert!(e.message.contains("undefined parameter `$r`"), "{e}");
+
+    let e = error(&scene(
+        r#"<shape type="sphere"><flaot name="radius" value="1"/></shape>"#,
+    ));
+    assert_eq!((e.line, e.column), (2, 22), "{e}");
+    assert!(e.to_string().contains("did you mean <float>?"), "{e}");
+
+    let e = error(&scene(
+        r#"<shape type="sphere"><ref id="nowhere"/></shape>"#,
+    ));
+    assert!(e.message.contains("no object has the id `nowhere`"), "{e}");
+
+    let e = error("<scene>\n</scene>");
+    assert!(e.message.contains("version"), "{e}");
+
+    let e = error(&scene(
+        r#"<shape type="sphere"><float name="radius" value="1"></shape>"#,
+    ));
+    assert_eq!(e.line, 2, "{e}");
+    assert!(e.message.contains("malformed XML"), "{e}");
+
+    let e = error(&scene(
+        r#"<shape type="sphere"><float name="radius" value="-1"/></shape>"#,
+    ));
+    assert!(e.message.contains("expected `radius` > 0"), "{e}");
+
+    let e = error(&scene(
+        r#"<bsdf type="blendbsdf" id="loop"><ref id="loop"/><bsdf type="diffuse"/></bsdf>
+        <shape type="sphere"><ref id="loop"/></shape>"#,
+    ));
+    assert!(e.message.contains("contains itself"), "{e}");
+
+    let e = error(&scene(r#"<include filename="missing.xml"/>"#));
+    assert!(e.message.contains("cannot read the included file"), "{e}");
+}
+
+#[test]
+fn what_plenum_lacks_is_warned_where_it_is_written() {
+    let l = load(&lit(r#"<shape type="sphere">
+            <bsdf type="roughconductor"><float name="alpha" value="0.2"/></bsdf>
+            <float name="sparkle" value="1"/>
+        </shape>
+        <medium type="homogeneous" id="fog"/>
+        <shape type="serialized"><string name="filename" value="x.serialized"/></shape>"#));
+    let all = l.warnings.join("\n");
+    assert_eq!(l.warnings.len(), 4, "{all}");
+    assert!(all.contains(":4:13") && all.contains("Beckmann"), "{all}");
+    assert!(
+        all.contains(":5:13") && all.contains("`sparkle` of the shape `sphere` is not supported"),
+        "{all}"
+    );
+    assert!(
+        all.contains(":7:9") && all.contains("<medium> is not supported"),
+        "{all}"
+    );
+    assert!(
+        all.contains(":8:9") && all.contains("`serialized` shape is not supported"),
+        "{all}"
+    );
+}
