@@ -47,7 +47,7 @@ fn lit(body: &str) -> String {
 }
 
 /// The material table of object `i`.
-fn material_of<'a>(t: &'a Table, i: usize) -> &'a Table {
+fn material_of(t: &Table, i: usize) -> &Table {
     let name = t["objects"][i]["material"].as_str().unwrap();
     t["materials"][name].as_table().unwrap()
 }
