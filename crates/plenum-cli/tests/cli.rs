@@ -389,6 +389,67 @@ fn convert_writes_a_native_scene_that_renders() {
     assert_eq!(o.status.code(), Some(2));
 }
 
+#[test]
+fn mitsuba_scenes_render_warn_and_fail_where_they_are_written() {
+    let tmp = temp_dir("mitsuba");
+    let dir = tmp.path();
+    let scene = write(
+        dir,
+        "scene.xml",
+        r#"<scene version="3.0.0">
+    <default name="spp" value="2"/>
+    <sensor type="perspective">
+        <float name="fov" value="40"/>
+        <transform name="to_world"><lookat origin="0 0 4" target="0 0 0" up="0 1 0"/></transform>
+        <sampler type="independent"><integer name="sample_count" value="$spp"/></sampler>
+        <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="16"/></film>
+    </sensor>
+    <emitter type="constant"/>
+    <shape type="sphere"><bsdf type="diffuse"><float name="glitter" value="1"/></bsdf></shape>
+</scene>
+"#,
+    );
+    let png = dir.join("x.png");
+    let o = plenum()
+        .arg("render")
+        .arg(&scene)
+        .args(["-q", "-o"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The film's size, and the property nothing reads, named where it is written.
+    let size = image_size(&png);
+    assert_eq!(size, (24, 16));
+    assert!(
+        stderr(&o).contains("scene.xml:10:47") && stderr(&o).contains("`glitter`"),
+        "{}",
+        stderr(&o)
+    );
+    let bad = write(dir, "bad.xml", "<scene version=\"3.0.0\">\n  <shape type=\"sphere\"><float name=\"radius\" value=\"$r\"/></shape>\n</scene>\n");
+    let o = plenum()
+        .arg("render")
+        .arg(&bad)
+        .args(["-q", "-o"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("bad.xml:2:") && stderr(&o).contains("undefined parameter `$r`"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+fn image_size(png: &Path) -> (u32, u32) {
+    let bytes = std::fs::read(png).unwrap();
+    // The IHDR chunk: width and height, big-endian, after the 8-byte signature and the
+    // chunk's length and type.
+    let be = |i: usize| u32::from_be_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+    (be(16), be(20))
+}
+
 /// A rays file (PLRAYS1, ../shared/bench/README.md): origin, t_min, direction, t_max each.
 fn write_rays(path: &Path, rays: &[[f32; 8]]) {
     let mut bytes = b"PLRAYS1\0".to_vec();

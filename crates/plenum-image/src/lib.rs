@@ -159,6 +159,20 @@ pub fn read_texture(path: &Path) -> Result<Texels, ImageError> {
         path: path.display().to_string(),
         source: e.into(),
     })?;
+    Ok(texels(img))
+}
+
+/// [`read_texture`] of an image file's bytes already read (an image inside a glTF buffer or
+/// data URI); `name` says where they came from in messages.
+pub fn decode_texture(bytes: &[u8], name: &str) -> Result<Texels, ImageError> {
+    let img = image::load_from_memory(bytes).map_err(|e| ImageError::Read {
+        path: name.to_string(),
+        source: e.into(),
+    })?;
+    Ok(texels(img))
+}
+
+fn texels(img: image::DynamicImage) -> Texels {
     let (w, h) = (img.width() as usize, img.height() as usize);
     let rgb = match img {
         image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_) => {
@@ -170,11 +184,11 @@ pub fn read_texture(path: &Path) -> Result<Texels, ImageError> {
             .map(|p| p.0.map(srgb_decode))
             .collect(),
     };
-    Ok(Texels {
+    Texels {
         width: w,
         height: h,
         rgb,
-    })
+    }
 }
 
 /// A float image of linear RGB, row-major from the top-left.

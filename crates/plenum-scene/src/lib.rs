@@ -2,6 +2,7 @@
 //! with located diagnostics and built into a core [`plenum_core::scene::Scene`].
 
 pub mod diagnostics;
+mod gltf;
 mod limits;
 mod mitsuba;
 mod model;
@@ -107,11 +108,12 @@ pub fn load_mesh(path: &Path) -> Result<plenum_core::geometry::TriangleMesh, Sce
 }
 
 /// The extensions of the scene files Plenum reads, by reader.
-pub const SCENE_EXTENSIONS: [&str; 6] = ["toml", "nff", "ray", "obj", "ply", "xml"];
+pub const SCENE_EXTENSIONS: [&str; 8] = ["toml", "nff", "ray", "obj", "ply", "xml", "gltf", "glb"];
 
 /// Reads a scene file, choosing the format by extension: `.toml` (the native format), `.nff`
 /// (Haines' Neutral File Format), `.ray` (the course ray tracer's format), `.obj` and `.ply`
-/// (a mesh, framed by a default camera and lights), `.xml` (Mitsuba 3); any other is refused. Relative paths
+/// (a mesh, framed by a default camera and lights), `.xml` (Mitsuba 3), `.gltf` and `.glb`
+/// (glTF 2.0); any other is refused. Relative paths
 /// inside are resolved against the file's folder.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
     let extension = path
@@ -127,7 +129,7 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
         };
         return Err(SceneError::file(
             path,
-            format!("not a scene file Plenum reads: {found}; the formats are .toml (native), .nff, .ray, .obj, .ply and .xml (Mitsuba 3)"),
+            format!("not a scene file Plenum reads: {found}; the formats are .toml (native), .nff, .ray, .obj, .ply, .xml (Mitsuba 3), .gltf and .glb (glTF 2.0)"),
         ));
     }
     let bytes = std::fs::read(path)
@@ -139,6 +141,14 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
 /// `path` names the file in messages and resolves relative paths inside. The fuzz targets
 /// call it.
 pub fn read_scene(path: &Path, extension: &str, bytes: Vec<u8>) -> Result<LoadedScene, SceneError> {
+    if extension == "gltf" || extension == "glb" {
+        let (builder, defaults, warnings) = gltf::parse(path, &bytes)?;
+        return Ok(LoadedScene {
+            scene: builder.build(),
+            defaults,
+            warnings,
+        });
+    }
     if extension == "obj" || extension == "ply" {
         // PLY is binary, and OBJ is read leniently by the model's reader.
         return model::model_from_bytes(path, extension, bytes);

@@ -160,3 +160,45 @@ fn xml_elements() {
             read("xml", text.as_bytes());
         });
 }
+
+#[test]
+fn gltf() {
+    bolero::check!().for_each(|bytes: &[u8]| {
+        read("gltf", bytes);
+        read("glb", bytes);
+    });
+}
+
+/// A valid glTF (a square in an embedded buffer, a camera, a light, a material) with random
+/// bytes overwritten: counts, offsets, indices, types and nesting go wrong in every way a
+/// file can be damaged, past the JSON parser.
+#[test]
+fn gltf_mutations() {
+    const VALID: &str = r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
+"nodes": [{"mesh": 0, "translation": [1, 0, 0], "children": [3]}, {"camera": 0, "translation": [0, 0, 4]},
+{"extensions": {"KHR_lights_punctual": {"light": 0}}}, {"mesh": 0, "scale": [2, 2, 2]}],
+"cameras": [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.1}}],
+"extensions": {"KHR_lights_punctual": {"lights": [{"type": "spot", "intensity": 5}]}},
+"meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 2}, "indices": 1, "material": 0}]}],
+"materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0.5}, "emissiveFactor": [0, 0, 0]}],
+"buffers": [{"byteLength": 60, "uri": "data:application/octet-stream;base64,AAAAvwAAAL8AAAAAAAAAPwAAAL8AAAAAAAAAPwAAAD8AAAAAAAAAvwAAAD8AAAAAAAABAAIAAAACAAMA"}],
+"bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 12}],
+"accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-0.5, -0.5, 0], "max": [0.5, 0.5, 0]},
+{"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
+{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC2", "byteOffset": 4}]}"#;
+    bolero::check!()
+        .with_type::<Vec<(u16, u8)>>()
+        .for_each(|edits| {
+            let mut bytes = VALID.as_bytes().to_vec();
+            for (at, b) in edits.iter().take(8) {
+                let i = *at as usize % bytes.len();
+                // Digits and structure more often than arbitrary bytes.
+                bytes[i] = match b % 4 {
+                    0 => b'0' + b % 10,
+                    1 => b"[]{},:\"-"[(*b as usize / 4) % 8],
+                    _ => *b,
+                };
+            }
+            read("gltf", &bytes);
+        });
+}

@@ -1,0 +1,856 @@
+//! `plenum render model.gltf` (or `.glb`): glTF 2.0 scenes. The `gltf` crate reads and
+//! validates the JSON (and a GLB's chunks); buffers, accessors and images are read here,
+//! each checked against the bytes it points into. The node hierarchy places meshes (a mesh
+//! used by several nodes is one mesh, instanced), the first camera and
+//! `KHR_lights_punctual` lights; metallic–roughness materials become Plenum's physically
+//! based ones (docs/gltf.md). What has no counterpart is warned about, naming where in the
+//! file it is (a JSON path such as `materials[2]`).
+
+use crate::diagnostics::SceneError;
+use crate::limits::MAX_NESTING;
+use crate::RenderDefaults;
+use gltf::accessor::{DataType, Dimensions};
+use plenum_core::camera::CameraSettings;
+use plenum_core::color::Color;
+use plenum_core::geometry::{Shape, TriangleMesh};
+use plenum_core::integrator::IntegratorKind;
+use plenum_core::light::{Attenuation, Light};
+use plenum_core::material::{
+    CoatedDiffuseMaterial, ConductorMaterial, ConductorSpec, DielectricMaterial, FloatTexture,
+    Material, Roughness, SpectralTexture, SpectrumKind, SpectrumValue,
+};
+use plenum_core::math::{Bounds3, Matrix4, Transform, Vec3};
+use plenum_core::scene::{MaterialId, SceneBuilder};
+use plenum_core::texture::{ImageTexture, Texture};
+use plenum_spectrum::Spectrum;
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+type Result<T> = std::result::Result<T, SceneError>;
+
+/// Parses a glTF 2.0 file (JSON or binary): the scene, its render defaults, and warnings.
+pub fn parse(path: &Path, bytes: &[u8]) -> Result<(SceneBuilder, RenderDefaults, Vec<String>)> {
+    let gltf = read(bytes).map_err(|e| located(path, bytes, e))?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let mut r = Reader {
+        path,
+        doc: &gltf.document,
+        buffers: Vec::new(),
+        builder: SceneBuilder::default(),
+        warnings: Vec::new(),
+        meshes: HashMap::new(),
+        materials: HashMap::new(),
+        camera: None,
+        bounds: Bounds3::default(),
+        lights: 0,
+    };
+    r.buffers = r.load_buffers(gltf.blob.as_deref(), base)?;
+    if gltf.document.animations().next().is_some() {
+        r.warn("animations are not supported: the scene is rendered as it stands");
+    }
+    if gltf.document.skins().next().is_some() {
+        r.warn("skins are not supported: skinned meshes are rendered in their rest pose");
+    }
+    let scene = match gltf.document.default_scene() {
+        Some(s) => Some(s),
+        None => gltf.document.scenes().next(),
+    };
+    match scene {
+        Some(scene) => {
+            for node in scene.nodes() {
+                r.node(node, Matrix4::IDENTITY, 0, base)?;
+            }
+        }
+        None => r.warn("the file has no scene: nothing to render"),
+    }
+    let mut defaults = RenderDefaults {
+        integrator: Some(IntegratorKind::Path),
+        sampler: plenum_core::sampling::SamplerKind::Random,
+        spp: 16,
+        ..RenderDefaults::default()
+    };
+    r.finish(&mut defaults);
+    Ok((r.builder, defaults, r.warnings))
+}
+
+/// The `gltf` crate's reading and validation, with one check of its own first: its
+/// validation looks up each primitive's POSITION accessor before checking that it exists
+/// (gltf-json 1.4.1, `mesh.rs`), and panics where it does not.
+fn read(bytes: &[u8]) -> std::result::Result<gltf::Gltf, gltf::Error> {
+    use gltf::json::validation::{Error, Validate};
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes)?;
+    let root = gltf.document.as_json();
+    let mut errors = Vec::new();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &primitive.attributes {
+                if index.value() >= root.accessors.len() {
+                    let at = gltf::json::Path::new()
+                        .field("meshes")
+                        .index(m)
+                        .field("primitives")
+                        .index(p)
+                        .field("attributes")
+                        .key(&format!("{semantic:?}"));
+                    errors.push((at, Error::IndexOutOfBounds));
+                }
+            }
+        }
+    }
+    if errors.is_empty() {
+        root.validate(root, gltf::json::Path::new, &mut |path, error| {
+            errors.push((path(), error))
+        });
+    }
+    if errors.is_empty() {
+        Ok(gltf)
+    } else {
+        Err(gltf::Error::Validation(errors))
+    }
+}
+
+/// A glTF error as a located one: JSON errors at their line and column, validation errors
+/// at their JSON path.
+fn located(path: &Path, bytes: &[u8], e: gltf::Error) -> SceneError {
+    match e {
+        gltf::Error::Deserialize(j) if !bytes.starts_with(b"glTF") => {
+            let text = String::from_utf8_lossy(bytes);
+            let offset = text
+                .split_inclusive('\n')
+                .take(j.line().saturating_sub(1))
+                .map(str::len)
+                .sum::<usize>()
+                + j.column().saturating_sub(1);
+            SceneError::at(
+                path,
+                &text,
+                offset..offset + 1,
+                format!("malformed glTF: {j}"),
+            )
+        }
+        gltf::Error::Validation(list) => {
+            let all: Vec<String> = list
+                .iter()
+                .take(5)
+                .map(|(p, e)| format!("{}: {e}", p.as_str()))
+                .collect();
+            SceneError::file(path, format!("invalid glTF: {}", all.join("; ")))
+        }
+        e => SceneError::file(path, format!("malformed glTF: {e}")),
+    }
+}
+
+struct Reader<'a> {
+    path: &'a Path,
+    doc: &'a gltf::Document,
+    buffers: Vec<Vec<u8>>,
+    builder: SceneBuilder,
+    warnings: Vec<String>,
+    /// Each (mesh, primitive) read once, for every node that uses it.
+    meshes: HashMap<(usize, usize), Option<Arc<TriangleMesh>>>,
+    /// Each material added once (None: glTF's default material), with its emission.
+    materials: HashMap<Option<usize>, (MaterialId, Color)>,
+    camera: Option<(gltf::Camera<'a>, Matrix4)>,
+    bounds: Bounds3,
+    lights: usize,
+}
+
+/// The column-major matrix glTF writes as Plenum's row-major one.
+fn matrix(m: [[f32; 4]; 4]) -> Matrix4 {
+    let mut out = Matrix4::IDENTITY;
+    for (c, column) in m.iter().enumerate() {
+        for (r, x) in column.iter().enumerate() {
+            out.0[r][c] = *x as f64;
+        }
+    }
+    out
+}
+
+impl<'a> Reader<'a> {
+    fn error(&self, at: &str, message: impl std::fmt::Display) -> SceneError {
+        SceneError::file(self.path, format!("{at}: {message}"))
+    }
+
+    fn warn(&mut self, message: impl std::fmt::Display) {
+        self.warnings
+            .push(format!("warning: {}: {message}", self.path.display()));
+    }
+
+    fn load_buffers(&self, blob: Option<&[u8]>, base: &Path) -> Result<Vec<Vec<u8>>> {
+        let mut out = Vec::new();
+        for b in self.doc.buffers() {
+            let at = format!("buffers[{}]", b.index());
+            let data = match b.source() {
+                gltf::buffer::Source::Bin => blob
+                    .ok_or_else(|| {
+                        self.error(&at, "refers to the GLB's binary chunk, which is missing")
+                    })?
+                    .to_vec(),
+                gltf::buffer::Source::Uri(uri) => self.uri(uri, base, &at)?,
+            };
+            if data.len() < b.length() {
+                return Err(self.error(
+                    &at,
+                    format!(
+                        "holds {} bytes, but its byteLength is {}",
+                        data.len(),
+                        b.length()
+                    ),
+                ));
+            }
+            out.push(data);
+        }
+        Ok(out)
+    }
+
+    /// The bytes a URI names: a `data:` URI's base64, or a file beside the glTF.
+    fn uri(&self, uri: &str, base: &Path, at: &str) -> Result<Vec<u8>> {
+        if let Some(rest) = uri.strip_prefix("data:") {
+            let Some((_, data)) = rest.split_once(";base64,") else {
+                return Err(self.error(at, "a data URI that is not base64"));
+            };
+            return base64(data).ok_or_else(|| self.error(at, "malformed base64 in a data URI"));
+        }
+        let file = base.join(percent_decode(uri));
+        std::fs::read(&file)
+            .map_err(|e| self.error(at, format!("cannot read {}: {e}", file.display())))
+    }
+
+    /// The bytes of an accessor's elements, checked: (data, offset of the first element,
+    /// stride, element size).
+    fn accessor_bytes(
+        &self,
+        a: &gltf::Accessor,
+        components: usize,
+    ) -> Result<(&[u8], usize, usize)> {
+        let at = format!("accessors[{}]", a.index());
+        if a.sparse().is_some() {
+            return Err(self.error(&at, "sparse accessors are not supported"));
+        }
+        let Some(view) = a.view() else {
+            return Err(self.error(
+                &at,
+                "an accessor without a bufferView (all zeros) is not supported",
+            ));
+        };
+        let size = a.data_type().size() * components;
+        let stride = view.stride().unwrap_or(size);
+        if stride < size {
+            return Err(self.error(
+                &at,
+                format!("a byteStride of {stride} for elements of {size} bytes"),
+            ));
+        }
+        let buffer = &self.buffers[view.buffer().index()];
+        let view_end = view.offset().checked_add(view.length());
+        let Some(data) = view_end.and_then(|end| buffer.get(view.offset()..end)) else {
+            return Err(self.error(
+                &format!("bufferViews[{}]", view.index()),
+                "reaches past the end of its buffer",
+            ));
+        };
+        let need = a
+            .count()
+            .checked_sub(1)
+            .and_then(|n| n.checked_mul(stride))
+            .and_then(|n| n.checked_add(size))
+            .and_then(|n| n.checked_add(a.offset()));
+        match need {
+            Some(n) if n <= data.len() => Ok((&data[a.offset()..], stride, size)),
+            _ => Err(self.error(
+                &at,
+                format!(
+                    "{} elements do not fit in its bufferView of {} bytes",
+                    a.count(),
+                    data.len()
+                ),
+            )),
+        }
+    }
+
+    /// An accessor of N floats per element (FLOAT, or normalised integers).
+    fn floats<const N: usize>(&self, a: &gltf::Accessor, what: &str) -> Result<Vec<[f64; N]>> {
+        let at = format!("accessors[{}]", a.index());
+        let dims = match a.dimensions() {
+            Dimensions::Scalar => 1,
+            Dimensions::Vec2 => 2,
+            Dimensions::Vec3 => 3,
+            Dimensions::Vec4 => 4,
+            _ => 0,
+        };
+        if dims != N {
+            return Err(self.error(&at, format!("{what} must have {N} components")));
+        }
+        let t = a.data_type();
+        if t != DataType::F32 && !a.normalized() {
+            return Err(self.error(&at, format!("{what} must be floats or normalised integers")));
+        }
+        let (data, stride, _) = self.accessor_bytes(a, N)?;
+        let c = t.size();
+        let read = |b: &[u8]| -> f64 {
+            match t {
+                DataType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                DataType::U8 => b[0] as f64 / 255.0,
+                DataType::I8 => (b[0] as i8 as f64 / 127.0).max(-1.0),
+                DataType::U16 => u16::from_le_bytes([b[0], b[1]]) as f64 / 65535.0,
+                DataType::I16 => (i16::from_le_bytes([b[0], b[1]]) as f64 / 32767.0).max(-1.0),
+                DataType::U32 => {
+                    u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64 / u32::MAX as f64
+                }
+            }
+        };
+        Ok((0..a.count())
+            .map(|i| {
+                let e = &data[i * stride..];
+                std::array::from_fn(|k| read(&e[k * c..]))
+            })
+            .collect())
+    }
+
+    fn indices(&self, a: &gltf::Accessor) -> Result<Vec<u32>> {
+        let at = format!("accessors[{}]", a.index());
+        if a.dimensions() != Dimensions::Scalar
+            || !matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
+        {
+            return Err(self.error(&at, "indices must be unsigned integer scalars"));
+        }
+        let (data, stride, _) = self.accessor_bytes(a, 1)?;
+        Ok((0..a.count())
+            .map(|i| {
+                let b = &data[i * stride..];
+                match a.data_type() {
+                    DataType::U8 => b[0] as u32,
+                    DataType::U16 => u16::from_le_bytes([b[0], b[1]]) as u32,
+                    _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+                }
+            })
+            .collect())
+    }
+
+    /// A primitive's triangles as a mesh (`None`, warned, for points and lines).
+    fn mesh(
+        &mut self,
+        mesh: &gltf::Mesh,
+        p: &gltf::Primitive,
+    ) -> Result<Option<Arc<TriangleMesh>>> {
+        let key = (mesh.index(), p.index());
+        if let Some(m) = self.meshes.get(&key) {
+            return Ok(m.clone());
+        }
+        let at = format!("meshes[{}].primitives[{}]", mesh.index(), p.index());
+        let mode = p.mode();
+        if !matches!(
+            mode,
+            gltf::mesh::Mode::Triangles
+                | gltf::mesh::Mode::TriangleStrip
+                | gltf::mesh::Mode::TriangleFan
+        ) {
+            self.warn(format!("{at}: {mode:?} are not surfaces: skipped"));
+            self.meshes.insert(key, None);
+            return Ok(None);
+        }
+        let Some(pos) = p.get(&gltf::Semantic::Positions) else {
+            return Err(self.error(&at, "a primitive without POSITION"));
+        };
+        let positions: Vec<Vec3> = self
+            .floats::<3>(&pos, "POSITION")?
+            .into_iter()
+            .map(|[x, y, z]| Vec3::new(x, y, z))
+            .collect();
+        let normals: Vec<Vec3> = match p.get(&gltf::Semantic::Normals) {
+            Some(n) => self
+                .floats::<3>(&n, "NORMAL")?
+                .into_iter()
+                .map(|[x, y, z]| Vec3::new(x, y, z))
+                .collect(),
+            None => Vec::new(),
+        };
+        // glTF's uv origin is the image's top-left, Plenum's its bottom-left.
+        let uvs: Vec<[f64; 2]> = match p.get(&gltf::Semantic::TexCoords(0)) {
+            Some(t) => self
+                .floats::<2>(&t, "TEXCOORD_0")?
+                .into_iter()
+                .map(|[u, v]| [u, 1.0 - v])
+                .collect(),
+            None => Vec::new(),
+        };
+        let index: Vec<u32> = match p.indices() {
+            Some(i) => self.indices(&i)?,
+            None => (0..positions.len() as u32).collect(),
+        };
+        let triangles: Vec<[u32; 3]> = match mode {
+            gltf::mesh::Mode::Triangles => {
+                index.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect()
+            }
+            gltf::mesh::Mode::TriangleStrip => (2..index.len())
+                .map(|i| {
+                    if i % 2 == 0 {
+                        [index[i - 2], index[i - 1], index[i]]
+                    } else {
+                        [index[i - 1], index[i - 2], index[i]]
+                    }
+                })
+                .collect(),
+            _ => (2..index.len())
+                .map(|i| [index[0], index[i - 1], index[i]])
+                .collect(),
+        };
+        let m = TriangleMesh::new(positions, triangles, normals, uvs)
+            .map_err(|e| self.error(&at, e))?;
+        let m = Some(Arc::new(m));
+        self.meshes.insert(key, m.clone());
+        Ok(m)
+    }
+
+    /// A texture as Plenum's image texture, times `factor`.
+    fn texture(
+        &mut self,
+        info: &gltf::texture::Info,
+        factor: [f64; 3],
+        base: &Path,
+        at: &str,
+    ) -> Result<Texture> {
+        if info.tex_coord() != 0 {
+            self.warn(format!(
+                "{at}: texture coordinates {} are not supported: using TEXCOORD_0",
+                info.tex_coord()
+            ));
+        }
+        if info.texture_transform().is_some() {
+            self.warn(format!(
+                "{at}: KHR_texture_transform is not supported: ignored"
+            ));
+        }
+        let sampler = info.texture().sampler();
+        if sampler.wrap_s() != gltf::texture::WrappingMode::Repeat
+            || sampler.wrap_t() != gltf::texture::WrappingMode::Repeat
+        {
+            self.warn(format!(
+                "{at}: only the repeat wrapping mode is supported: repeating"
+            ));
+        }
+        let image = info.texture().source();
+        let iat = format!("images[{}]", image.index());
+        let texels = match image.source() {
+            gltf::image::Source::View { view, .. } => {
+                let buffer = &self.buffers[view.buffer().index()];
+                let bytes = view
+                    .offset()
+                    .checked_add(view.length())
+                    .and_then(|end| buffer.get(view.offset()..end))
+                    .ok_or_else(|| {
+                        self.error(&iat, "its bufferView reaches past the end of its buffer")
+                    })?;
+                plenum_image::decode_texture(bytes, &iat)
+            }
+            gltf::image::Source::Uri { uri, .. } => {
+                let bytes = self.uri(uri, base, &iat)?;
+                plenum_image::decode_texture(&bytes, uri)
+            }
+        }
+        .map_err(|e| self.error(&iat, e))?;
+        let (width, height) = (texels.width, texels.height);
+        let texels = texels
+            .rgb
+            .iter()
+            .map(|p| {
+                Color::new(
+                    p[0] as f64 * factor[0],
+                    p[1] as f64 * factor[1],
+                    p[2] as f64 * factor[2],
+                )
+            })
+            .collect();
+        let image = ImageTexture::new(width, height, texels, [1.0, 1.0])
+            .ok_or_else(|| self.error(&iat, "the image is empty"))?;
+        Ok(Texture::Image(Arc::new(image)))
+    }
+
+    /// A glTF material as Plenum's, and its emitted radiance: a dielectric coat over the base
+    /// colour (`coateddiffuse`), a conductor of that colour (pbrt-v4's reflectance form) as
+    /// far as it is metallic, glass as far as it transmits.
+    fn material(&mut self, m: &gltf::Material, base: &Path) -> Result<(MaterialId, Color)> {
+        if let Some(&done) = self.materials.get(&m.index()) {
+            return Ok(done);
+        }
+        let at = match m.index() {
+            Some(i) => format!("materials[{i}]"),
+            None => "the default material".to_string(),
+        };
+        let name = m.name().map(str::to_string).unwrap_or_else(|| at.clone());
+        let pbr = m.pbr_metallic_roughness();
+        let [r, g, b, _] = pbr.base_color_factor().map(|x| x as f64);
+        let base_color = match pbr.base_color_texture() {
+            Some(info) => SpectralTexture::from_texture(
+                self.texture(&info, [r, g, b], base, &format!("{at}.baseColorTexture"))?,
+                SpectrumKind::Albedo,
+            ),
+            None => SpectralTexture::constant(Color::new(r, g, b), SpectrumKind::Albedo),
+        };
+        if pbr.metallic_roughness_texture().is_some() {
+            self.warn(format!(
+                "{at}: the metallicRoughnessTexture is not supported: using its factors"
+            ));
+        }
+        let alpha = (pbr.roughness_factor() as f64).clamp(0.0, 1.0).powi(2);
+        let roughness = Roughness {
+            u: FloatTexture::Constant(alpha),
+            v: FloatTexture::Constant(alpha),
+            remap: false,
+        };
+        let metallic = (pbr.metallic_factor() as f64).clamp(0.0, 1.0);
+        let ior = m.ior().map_or(1.5, |x| x as f64);
+        if !(ior >= 1.0 && ior.is_finite()) {
+            return Err(self.error(&at, format!("an ior of {ior}: expected 1 or more")));
+        }
+        let eta = SpectrumValue::new(Spectrum::Constant(ior), SpectrumKind::Unbounded);
+        let transmission = m.transmission().map_or(0.0, |t| {
+            if t.transmission_texture().is_some() {
+                self.warnings.push(format!(
+                    "warning: {}: {at}: the transmissionTexture is not supported: using its factor",
+                    self.path.display()
+                ));
+            }
+            (t.transmission_factor() as f64).clamp(0.0, 1.0)
+        });
+        if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
+            self.warn(format!(
+                "{at}: alphaMode {:?} is not supported: opaque",
+                m.alpha_mode()
+            ));
+        }
+        if m.normal_texture().is_some() {
+            self.warn(format!(
+                "{at}: the normalTexture is not supported: the surface is smooth"
+            ));
+        }
+        if let Some(s) = m.specular() {
+            if s.specular_factor() != 1.0
+                || s.specular_color_factor() != [1.0; 3]
+                || s.specular_texture().is_some()
+                || s.specular_color_texture().is_some()
+            {
+                self.warn(format!("{at}: KHR_materials_specular is not supported: the coat reflects as its ior says"));
+            }
+        }
+        if m.volume().is_some() {
+            self.warn(format!(
+                "{at}: KHR_materials_volume is not supported: the glass is clear"
+            ));
+        }
+        let strength = m.emissive_strength().map_or(1.0, |x| x as f64);
+        let [er, eg, eb] = m.emissive_factor().map(|x| x as f64 * strength);
+        if m.emissive_texture().is_some() {
+            self.warn(format!(
+                "{at}: the emissiveTexture is not supported: using its factor"
+            ));
+        }
+        let emission = Color::new(er, eg, eb);
+
+        let coat = Material::CoatedDiffuse(CoatedDiffuseMaterial {
+            reflectance: base_color.clone(),
+            roughness: roughness.clone(),
+            thickness: 0.01,
+            eta: eta.clone(),
+            albedo: SpectralTexture::constant(Color::BLACK, SpectrumKind::Albedo),
+            g: 0.0,
+            max_depth: 10,
+            samples: 1,
+        });
+        let glass = || {
+            Material::Dielectric(DielectricMaterial {
+                eta: eta.clone(),
+                roughness: roughness.clone(),
+            })
+        };
+        let metal = || {
+            Material::Conductor(ConductorMaterial {
+                spec: ConductorSpec::Reflectance(base_color.clone()),
+                roughness: roughness.clone(),
+            })
+        };
+        let add = |b: &mut SceneBuilder, suffix: &str, m: Material| {
+            b.add_material(format!("{name}{suffix}"), m)
+        };
+        let dielectric = match transmission {
+            t if t >= 1.0 => glass(),
+            t if t > 0.0 => {
+                let a = add(&mut self.builder, " (coat)", coat);
+                let b = add(&mut self.builder, " (glass)", glass());
+                Material::Mix {
+                    materials: [a, b],
+                    amount: FloatTexture::Constant(t),
+                }
+            }
+            _ => coat,
+        };
+        let material = match metallic {
+            x if x >= 1.0 => metal(),
+            x if x > 0.0 => {
+                let a = add(&mut self.builder, " (dielectric)", dielectric);
+                let b = add(&mut self.builder, " (metal)", metal());
+                Material::Mix {
+                    materials: [a, b],
+                    amount: FloatTexture::Constant(x),
+                }
+            }
+            _ => dielectric,
+        };
+        let id = self.builder.add_material(name, material);
+        self.materials.insert(m.index(), (id, emission));
+        Ok((id, emission))
+    }
+
+    fn node(
+        &mut self,
+        node: gltf::Node<'a>,
+        parent: Matrix4,
+        depth: usize,
+        base: &Path,
+    ) -> Result<()> {
+        let at = format!("nodes[{}]", node.index());
+        if depth > MAX_NESTING {
+            return Err(self.error(
+                &at,
+                format!("nodes nested deeper than {MAX_NESTING} (does a node contain itself?)"),
+            ));
+        }
+        let world = parent.mul(&matrix(node.transform().matrix()));
+        if !world.0.iter().flatten().all(|x| x.is_finite()) {
+            return Err(self.error(&at, "a transform that is not finite"));
+        }
+        let name = node.name().map_or_else(|| at.clone(), str::to_string);
+        if let Some(mesh) = node.mesh() {
+            match Transform::from_matrix(world) {
+                None => self.warn(format!("{at}: a singular transform: its mesh is skipped")),
+                Some(to_world) => {
+                    for p in mesh.primitives() {
+                        let Some(m) = self.mesh(&mesh, &p)? else {
+                            continue;
+                        };
+                        let (material, emission) = self.material(&p.material(), base)?;
+                        self.bounds = self
+                            .bounds
+                            .union(&transformed_bounds(&m.bounds(), &to_world));
+                        let pname = if mesh.primitives().len() > 1 {
+                            format!("{name}.{}", p.index())
+                        } else {
+                            name.clone()
+                        };
+                        if emission.r > 0.0 || emission.g > 0.0 || emission.b > 0.0 {
+                            self.builder.add_emissive_object(
+                                pname,
+                                Shape::Mesh(m),
+                                to_world,
+                                material,
+                                emission,
+                                true,
+                                1,
+                            );
+                            self.lights += 1;
+                        } else {
+                            self.builder
+                                .add_object(pname, Shape::Mesh(m), to_world, material);
+                        }
+                    }
+                }
+            }
+        }
+        if let Some(camera) = node.camera() {
+            if self.camera.is_none() {
+                self.camera = Some((camera, world));
+            } else {
+                self.warn(format!(
+                    "{at}: another camera: Plenum renders the first one met"
+                ));
+            }
+        }
+        if let Some(light) = node.light() {
+            self.light(&light, world, &at);
+        }
+        for child in node.children() {
+            self.node(child, world, depth + 1, base)?;
+        }
+        Ok(())
+    }
+
+    /// A `KHR_lights_punctual` light, placed by its node: at its origin, shining along −z.
+    fn light(&mut self, light: &gltf::khr_lights_punctual::Light, world: Matrix4, at: &str) {
+        let t = Transform::from_matrix(world).unwrap_or(Transform::IDENTITY);
+        let [r, g, b] = light.color().map(|x| x as f64);
+        let intensity = Color::new(r, g, b) * light.intensity().max(0.0) as f64;
+        if light.range().is_some() {
+            self.warn(format!(
+                "{at}: a light's range is not supported: it reaches everywhere"
+            ));
+        }
+        let position = t.point(Vec3::ZERO);
+        let direction = t.vector(-Vec3::Z).normalized();
+        if !(direction.x.is_finite() && direction.y.is_finite() && direction.z.is_finite()) {
+            self.warn(format!(
+                "{at}: a light whose transform is degenerate: skipped"
+            ));
+            return;
+        }
+        let name = light
+            .name()
+            .map_or_else(|| format!("{at} light"), str::to_string);
+        let l = match light.kind() {
+            gltf::khr_lights_punctual::Kind::Point => Light::Point {
+                position,
+                intensity,
+                attenuation: Attenuation::default(),
+            },
+            gltf::khr_lights_punctual::Kind::Directional => Light::Directional {
+                direction,
+                intensity,
+            },
+            gltf::khr_lights_punctual::Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => {
+                let outer = (outer_cone_angle as f64).clamp(0.0, std::f64::consts::FRAC_PI_2);
+                let inner = (inner_cone_angle as f64).clamp(0.0, outer);
+                Light::Spot {
+                    position,
+                    direction,
+                    cos_inner: inner.cos(),
+                    cos_outer: outer.cos(),
+                    intensity,
+                    attenuation: Attenuation::default(),
+                }
+            }
+        };
+        self.builder.add_light(name, l);
+        self.lights += 1;
+    }
+
+    /// The camera (the first met, or one framing the scene) and, without lights, a sky.
+    fn finish(&mut self, defaults: &mut RenderDefaults) {
+        match self.camera.take() {
+            Some((camera, world)) => {
+                let t = Transform::from_matrix(world).unwrap_or(Transform::IDENTITY);
+                let position = t.point(Vec3::ZERO);
+                let forward = t.vector(-Vec3::Z).normalized();
+                let up = t.vector(Vec3::Y).normalized();
+                let finite = |v: Vec3| v.x.is_finite() && v.y.is_finite() && v.z.is_finite();
+                if !(finite(forward) && finite(up) && forward.cross(up).length() > 1e-9) {
+                    self.warn(format!("cameras[{}]: its node's transform is degenerate: a camera framing the scene instead", camera.index()));
+                    return self.finish(defaults);
+                }
+                let fov = match camera.projection() {
+                    gltf::camera::Projection::Perspective(p) => {
+                        if let Some(aspect) = p.aspect_ratio().filter(|a| *a > 0.0 && a.is_finite())
+                        {
+                            defaults.height = 480;
+                            defaults.width =
+                                ((480.0 * aspect as f64).round() as u32).clamp(1, 1 << 16);
+                        }
+                        (p.yfov() as f64).to_degrees().clamp(0.01, 179.0)
+                    }
+                    gltf::camera::Projection::Orthographic(_) => {
+                        self.warn(format!("cameras[{}]: orthographic cameras are not supported: a perspective one of 40° from the same place", camera.index()));
+                        40.0
+                    }
+                };
+                self.builder.camera = CameraSettings {
+                    position,
+                    look_at: position + forward,
+                    up,
+                    fov_degrees: fov,
+                    ..CameraSettings::default()
+                };
+            }
+            None => {
+                // Frame the bounding sphere from the front-right, above, as for bare meshes.
+                let b = self.bounds;
+                let (center, radius) = if b.min.x <= b.max.x {
+                    b.bounding_sphere()
+                } else {
+                    (Vec3::ZERO, 1.0)
+                };
+                let radius = radius.max(1e-9);
+                let fov: f64 = 35.0;
+                let direction = Vec3::new(0.6, 0.45, 1.0).normalized();
+                let distance = radius / (fov.to_radians() * 0.5).sin() * 1.05;
+                self.builder.camera = CameraSettings {
+                    position: center + direction * distance,
+                    look_at: center,
+                    up: Vec3::Y,
+                    fov_degrees: fov,
+                    ..CameraSettings::default()
+                };
+            }
+        }
+        if self.lights == 0 {
+            self.warn("no lights: a uniform white sky (radiance 1) lights the scene");
+            self.builder.add_light(
+                "sky",
+                Light::Infinite {
+                    radiance: Color::WHITE,
+                },
+            );
+        }
+    }
+}
+
+/// The world bounds of `b` under `t`: its eight corners transformed.
+fn transformed_bounds(b: &Bounds3, t: &Transform) -> Bounds3 {
+    let mut out = Bounds3::default();
+    for i in 0..8 {
+        let c = Vec3::new(
+            if i & 1 == 0 { b.min.x } else { b.max.x },
+            if i & 2 == 0 { b.min.y } else { b.max.y },
+            if i & 4 == 0 { b.min.z } else { b.max.z },
+        );
+        out = out.union_point(t.point(c));
+    }
+    out
+}
+
+/// Standard base64 (RFC 4648), padding optional; `None` on any other character.
+fn base64(s: &str) -> Option<Vec<u8>> {
+    let mut out = Vec::with_capacity(s.len() * 3 / 4);
+    let (mut acc, mut bits) = (0u32, 0);
+    for c in s.bytes() {
+        let v = match c {
+            b'A'..=b'Z' => c - b'A',
+            b'a'..=b'z' => c - b'a' + 26,
+            b'0'..=b'9' => c - b'0' + 52,
+            b'+' | b'-' => 62,
+            b'/' | b'_' => 63,
+            b'=' => break,
+            b' ' | b'\n' | b'\r' | b'\t' => continue,
+            _ => return None,
+        };
+        acc = (acc << 6) | v as u32;
+        bits += 6;
+        if bits >= 8 {
+            bits -= 8;
+            out.push((acc >> bits) as u8);
+            acc &= (1 << bits) - 1;
+        }
+    }
+    Some(out)
+}
+
+/// A URI's %XX escapes decoded (file names with spaces are written %20).
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        if b[i] == b'%' && i + 2 < b.len() {
+            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}

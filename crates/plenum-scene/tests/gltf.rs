@@ -1,0 +1,343 @@
+//! glTF 2.0 scenes (`plenum render model.gltf` / `.glb`), on small files written here:
+//! buffers in data URIs, files and GLB chunks, the node hierarchy and instancing, cameras and
+//! handedness, punctual lights, the metallic–roughness materials, and located errors.
+
+mod common;
+
+use common::integrators::{draw, path_settings};
+use plenum_core::integrator::ColorMode;
+use plenum_scene::{load_scene, to_toml, LoadedScene, SceneError};
+use toml::{Table, Value};
+
+fn base64(bytes: &[u8]) -> String {
+    const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for c in bytes.chunks(3) {
+        let n = (c[0] as u32) << 16
+            | (*c.get(1).unwrap_or(&0) as u32) << 8
+            | *c.get(2).unwrap_or(&0) as u32;
+        for i in 0..4 {
+            if i <= c.len() {
+                out.push(A[(n >> (18 - 6 * i) & 63) as usize] as char);
+            } else {
+                out.push('=');
+            }
+        }
+    }
+    out
+}
+
+/// A unit square in the xy plane facing +z (two triangles): its buffer, positions then
+/// 16-bit indices.
+fn square() -> Vec<u8> {
+    let mut b = Vec::new();
+    for p in [
+        [-0.5f32, -0.5, 0.0],
+        [0.5, -0.5, 0.0],
+        [0.5, 0.5, 0.0],
+        [-0.5, 0.5, 0.0],
+    ] {
+        for x in p {
+            b.extend(x.to_le_bytes());
+        }
+    }
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        b.extend(i.to_le_bytes());
+    }
+    b
+}
+
+/// A glTF document around the square's buffer at `uri`: the scene's `roots` (node indices),
+/// `nodes`, `materials`, and extra top-level members (`cameras`, `extensions`, …).
+fn document(uri: &str, roots: &str, nodes: &str, materials: &str, extra: &str) -> String {
+    format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "scene": 0,
+  "scenes": [{{"nodes": [{roots}]}}],
+  "nodes": [{nodes}],
+  "meshes": [{{"name": "square", "primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1, "material": 0}}]}}],
+  "materials": [{materials}],
+  "buffers": [{{"byteLength": 60, "uri": "{uri}"}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": 12}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-0.5, -0.5, 0], "max": [0.5, 0.5, 0]}},
+    {{"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"}}
+  ]{extra}
+}}"#,
+    )
+}
+
+fn data_uri() -> String {
+    format!("data:application/octet-stream;base64,{}", base64(&square()))
+}
+
+fn load_files(files: &[(&str, &[u8])]) -> Result<LoadedScene, SceneError> {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, bytes) in files {
+        std::fs::write(dir.path().join(name), bytes).unwrap();
+    }
+    load_scene(&dir.path().join(files[0].0))
+}
+
+fn load(text: &str) -> LoadedScene {
+    load_files(&[("scene.gltf", text.as_bytes())]).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn native(l: &LoadedScene) -> Table {
+    to_toml(&l.scene, &l.defaults).parse().unwrap()
+}
+
+fn number(v: &Value) -> f64 {
+    v.as_float()
+        .or_else(|| v.as_integer().map(|i| i as f64))
+        .unwrap()
+}
+
+const GREY: &str =
+    r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0}}"#;
+
+#[test]
+fn nodes_place_one_mesh_many_times() {
+    // Two nodes use the mesh: translated by +2 in x, and by −2 under a parent scaled by 2.
+    let l = load(&document(
+        &data_uri(),
+        "0, 1",
+        r#"{"mesh": 0, "translation": [2, 0, 0]},
+           {"scale": [2, 2, 2], "children": [2]},
+           {"mesh": 0, "translation": [-1, 0, 0]}"#,
+        GREY,
+        "",
+    ));
+    let t = native(&l);
+    let objects = t["objects"].as_array().unwrap();
+    assert_eq!(objects.len(), 2);
+    // Instanced: one mesh table, referenced twice.
+    assert_eq!(t["meshes"].as_table().unwrap().len(), 1, "{t}");
+    let b = l.scene.bounds();
+    assert!(
+        (b.min.x + 3.0).abs() < 1e-6 && (b.max.x - 2.5).abs() < 1e-6,
+        "{b:?}"
+    );
+    assert!(
+        (b.max.y - 1.0).abs() < 1e-6,
+        "the scaled copy is 2 high: {b:?}"
+    );
+    // No camera and no light: a framing camera and a sky, each said.
+    assert_eq!(l.warnings.len(), 1, "{:?}", l.warnings);
+    assert!(l.warnings[0].contains("no lights"), "{:?}", l.warnings);
+}
+
+#[test]
+fn the_camera_looks_down_minus_z_with_x_to_the_right() {
+    // A camera 4 units up +z looking back at the origin; an emissive square at x = +1.2
+    // appears in the right half, one at y = +1.2 in the top half.
+    let picture = |x: f64, y: f64| {
+        let l = load(&document(
+            &data_uri(),
+            "0, 1",
+            &format!(
+                r#"{{"mesh": 0, "translation": [{x}, {y}, 0]}},
+                   {{"camera": 0, "translation": [0, 0, 4]}}"#
+            ),
+            r#"{"emissiveFactor": [1, 1, 1], "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}}"#,
+            r#", "cameras": [{"type": "perspective", "perspective": {"yfov": 1.0, "aspectRatio": 1.0, "znear": 0.1}}]"#,
+        ));
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        let mut l = l;
+        l.defaults.width = 32;
+        l.defaults.height = 32;
+        let image = draw(&l, &path_settings(&l, 1, ColorMode::Rgb, 3));
+        let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+        for (i, p) in image.iter().enumerate() {
+            if p[0] > 0.5 {
+                sx += (i % 32) as f64;
+                sy += (i / 32) as f64;
+                n += 1.0;
+            }
+        }
+        assert!(n > 0.0, "the square is seen");
+        (sx / n, sy / n)
+    };
+    let (x, y) = picture(1.2, 0.0);
+    assert!(
+        x > 20.0 && (y - 15.5).abs() < 2.0,
+        "a square at +x lands at ({x}, {y})"
+    );
+    let (x, y) = picture(0.0, 1.2);
+    assert!(
+        (x - 15.5).abs() < 2.0 && y < 12.0,
+        "a square at +y lands at ({x}, {y})"
+    );
+}
+
+#[test]
+fn metallic_roughness_materials_map_onto_plenums() {
+    let materials = [
+        r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.2, 0.1, 1], "metallicFactor": 0, "roughnessFactor": 0.5}}"#,
+        r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.6, 0.2, 1], "metallicFactor": 1, "roughnessFactor": 0.2}}"#,
+        r#"{"pbrMetallicRoughness": {"metallicFactor": 0.25}}"#,
+        r#"{"pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0}, "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_ior": {"ior": 1.45}}}"#,
+        r#"{"emissiveFactor": [1, 0.5, 0.25], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}}"#,
+    ];
+    let kinds: Vec<Table> = materials
+        .iter()
+        .map(|m| {
+            let l = load(&document(&data_uri(), "0", r#"{"mesh": 0}"#, m, ""));
+            let t = native(&l);
+            let name = t["objects"][0]["material"].as_str().unwrap().to_string();
+            let mut m = t["materials"][&name].as_table().unwrap().clone();
+            if let Some(e) = t["objects"][0].get("emission") {
+                m.insert("emission".into(), e.clone());
+            }
+            m
+        })
+        .collect();
+    // A dielectric base: a coat over the base colour, α = roughness².
+    assert_eq!(kinds[0]["type"].as_str(), Some("coateddiffuse"));
+    let r: Vec<f64> = kinds[0]["reflectance"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(number)
+        .collect();
+    assert_eq!(
+        r,
+        [0.800000011920929, 0.20000000298023224, 0.10000000149011612]
+    );
+    assert!((number(&kinds[0]["roughness"][0]) - 0.25).abs() < 1e-12);
+    assert!((number(&kinds[0]["eta"]) - 1.5).abs() < 1e-12);
+    // A metal: the base colour as its reflectance.
+    assert_eq!(kinds[1]["type"].as_str(), Some("conductor"));
+    assert!(kinds[1].contains_key("reflectance"), "{:?}", kinds[1]);
+    // In between: the metal with probability `metallic`.
+    assert_eq!(kinds[2]["type"].as_str(), Some("mix"));
+    assert_eq!(number(&kinds[2]["amount"]), 0.25);
+    // Transmission: glass of the given index.
+    assert_eq!(kinds[3]["type"].as_str(), Some("dielectric"));
+    assert!((number(&kinds[3]["eta"]) - 1.45).abs() < 1e-6);
+    // Emission times its strength: an area light on the mesh.
+    let e: Vec<f64> = kinds[4]["emission"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(number)
+        .collect();
+    assert_eq!(e, [4.0, 2.0, 1.0]);
+}
+
+#[test]
+fn punctual_lights_shine_along_minus_z_of_their_node() {
+    let l = load(&document(
+        &data_uri(),
+        "0, 1, 2",
+        r#"{"mesh": 0},
+           {"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [0, 3, 0]},
+           {"extensions": {"KHR_lights_punctual": {"light": 1}}, "rotation": [-0.7071068, 0, 0, 0.7071068]}"#,
+        GREY,
+        r#", "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "point", "color": [1, 0.5, 0.5], "intensity": 10},
+            {"type": "directional", "intensity": 2}
+        ]}}"#,
+    ));
+    let t = native(&l);
+    let lights = t["lights"].as_array().unwrap();
+    let point = lights
+        .iter()
+        .find(|x| x["type"].as_str() == Some("point"))
+        .unwrap();
+    let at: Vec<f64> = point["position"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(number)
+        .collect();
+    assert!((at[1] - 3.0).abs() < 1e-9, "{at:?}");
+    let sun = lights
+        .iter()
+        .find(|x| x["type"].as_str() == Some("directional"))
+        .unwrap();
+    // −z turned −90° about x points down, −y.
+    let d: Vec<f64> = sun["direction"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(number)
+        .collect();
+    assert!(
+        d[0].abs() < 1e-6 && (d[1] + 1.0).abs() < 1e-6 && d[2].abs() < 1e-6,
+        "{d:?}"
+    );
+}
+
+#[test]
+fn buffers_are_read_from_files_and_glb_chunks_alike() {
+    let reference = native(&load(&document(
+        &data_uri(),
+        "0",
+        r#"{"mesh": 0}"#,
+        GREY,
+        "",
+    )));
+    // The buffer in a file beside the glTF (its name escaped as a URI).
+    let text = document("my%20square.bin", "0", r#"{"mesh": 0}"#, GREY, "");
+    let l = load_files(&[
+        ("scene.gltf", text.as_bytes()),
+        ("my square.bin", &square()),
+    ])
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(native(&l)["objects"], reference["objects"]);
+    // The same as a GLB: a JSON chunk and a BIN chunk, each padded to 4 bytes.
+    let json = document("", "0", r#"{"mesh": 0}"#, GREY, "").replace(r#", "uri": """#, "");
+    let mut json = json.into_bytes();
+    while !json.len().is_multiple_of(4) {
+        json.push(b' ');
+    }
+    let bin = square();
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut glb = Vec::new();
+    glb.extend(b"glTF");
+    glb.extend(2u32.to_le_bytes());
+    glb.extend((total as u32).to_le_bytes());
+    glb.extend((json.len() as u32).to_le_bytes());
+    glb.extend(b"JSON");
+    glb.extend(&json);
+    glb.extend((bin.len() as u32).to_le_bytes());
+    glb.extend(b"BIN\0");
+    glb.extend(&bin);
+    let l = load_files(&[("scene.glb", &glb)]).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(native(&l)["objects"], reference["objects"]);
+}
+
+#[test]
+fn bad_files_are_refused_with_where() {
+    let err = |text: &str| match load_files(&[("scene.gltf", text.as_bytes())]) {
+        Ok(_) => panic!("expected an error"),
+        Err(e) => e,
+    };
+    // Malformed JSON: its line and column.
+    let e = err("{\n  \"asset\": {\"version\": \"2.0\"},\n  \"nodes\": [,]\n}");
+    assert_eq!(e.line, 3, "{e}");
+    assert!(e.message.contains("malformed glTF"), "{e}");
+    // An accessor reaching past its buffer view.
+    let text = document(&data_uri(), "0", r#"{"mesh": 0}"#, GREY, "")
+        .replace(r#""count": 4"#, r#""count": 40"#);
+    let e = err(&text);
+    assert!(e.message.contains("accessors[0]"), "{e}");
+    // A buffer file that is not there.
+    let e = err(&document("missing.bin", "0", r#"{"mesh": 0}"#, GREY, ""));
+    assert!(
+        e.message.contains("buffers[0]") && e.message.contains("missing.bin"),
+        "{e}"
+    );
+    // A node that contains itself.
+    let text = document(
+        &data_uri(),
+        "0",
+        r#"{"mesh": 0, "children": [0]}"#,
+        GREY,
+        "",
+    );
+    let e = err(&text);
+    assert!(e.message.contains("nodes"), "{e}");
+}
