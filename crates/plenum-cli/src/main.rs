@@ -46,7 +46,7 @@ enum Command {
     TracePixel(TracePixelArgs),
     /// Measure an acceleration structure on a rays file: build time, memory, Mrays/s.
     Bench(bench::BenchArgs),
-    /// Write any scene Plenum reads (.toml, .nff, .ray, .obj, .ply, Mitsuba 3 .xml, glTF .gltf/.glb) in the native format.
+    /// Write any scene Plenum reads (.toml, .nff, .ray, .obj, .ply, Mitsuba 3 .xml, glTF .gltf/.glb, pbrt-v4 .pbrt) in the native format.
     Convert(ConvertArgs),
     /// Sum film files (.plf) of one render's sample ranges (`render --samples A..B`) into
     /// its image.

@@ -46,6 +46,9 @@ pub struct CameraSettings {
     /// Where the camera is and looks at time 1, when it moves; at time 0 it is at
     /// `position` looking at `look_at`, and in between on the straight line.
     pub motion: Option<(Vec3, Vec3)>,
+    /// The image's x axis is up × view instead of view × up: the mirror image, as pbrt's
+    /// left-handed camera space sees a scene (and Mitsuba's through a mirroring transform).
+    pub left_handed: bool,
 }
 
 impl Default for CameraSettings {
@@ -58,6 +61,7 @@ impl Default for CameraSettings {
             lens: Lens::default(),
             shutter: [0.0, 1.0],
             motion: None,
+            left_handed: false,
         }
     }
 }
@@ -88,13 +92,15 @@ struct Frame {
 }
 
 impl Frame {
-    fn new(position: Vec3, look_at: Vec3, up: Vec3) -> Frame {
+    /// `left_handed`: the image's right is up × forward (pbrt's camera space) rather than
+    /// forward × up, so that the picture is the mirror image.
+    fn new(position: Vec3, look_at: Vec3, up: Vec3, left_handed: bool) -> Frame {
         let forward = (look_at - position).normalized();
         let right = forward.cross(up).normalized();
         Frame {
             position,
             forward,
-            right,
+            right: if left_handed { -right } else { right },
             up: right.cross(forward),
         }
     }
@@ -122,7 +128,7 @@ impl Camera {
         let half_height = (s.fov_degrees.to_radians() * 0.5).tan();
         Camera {
             settings: *s,
-            frame: Frame::new(s.position, s.look_at, s.up),
+            frame: Frame::new(s.position, s.look_at, s.up, s.left_handed),
             half_width: half_height * width as f64 / height as f64,
             half_height,
             pixel_size: 2.0 * half_height / height as f64,
@@ -178,6 +184,7 @@ impl Camera {
                     s.position + (position - s.position) * t,
                     s.look_at + (look_at - s.look_at) * t,
                     s.up,
+                    s.left_handed,
                 )
             }
         }
@@ -331,6 +338,19 @@ mod tests {
         assert!((top.y / -top.z - 1.0).abs() < 1e-12);
         let right = cam.ray(200.0, 50.0).direction;
         assert!((right.x / -right.z - 2.0).abs() < 1e-12);
+        // Left-handed (pbrt's camera space): the mirror image, the top unchanged.
+        let mirrored = Camera::new(
+            &CameraSettings {
+                left_handed: true,
+                ..s
+            },
+            200,
+            100,
+        );
+        let right = mirrored.ray(200.0, 50.0).direction;
+        assert!((right.x / -right.z + 2.0).abs() < 1e-12);
+        let top = mirrored.ray(100.0, 0.0).direction;
+        assert!((top.y / -top.z - 1.0).abs() < 1e-12);
     }
 
     /// A camera ray's importance finds the raster point it was made for, through a pinhole
@@ -339,8 +359,9 @@ mod tests {
     #[test]
     fn importance_inverts_the_camera() {
         use crate::sampling::Rng;
-        for radius in [0.0, 0.3] {
+        for (radius, left_handed) in [(0.0, false), (0.3, false), (0.0, true), (0.3, true)] {
             let s = CameraSettings {
+                left_handed,
                 position: Vec3::new(1.0, 2.0, 10.0),
                 look_at: Vec3::new(0.0, 0.5, 0.0),
                 fov_degrees: 50.0,

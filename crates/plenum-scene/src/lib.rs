@@ -10,6 +10,7 @@ mod mtl;
 mod native;
 mod nff;
 mod obj;
+mod pbrt;
 mod ply;
 mod ray;
 pub mod ray_files;
@@ -108,12 +109,14 @@ pub fn load_mesh(path: &Path) -> Result<plenum_core::geometry::TriangleMesh, Sce
 }
 
 /// The extensions of the scene files Plenum reads, by reader.
-pub const SCENE_EXTENSIONS: [&str; 8] = ["toml", "nff", "ray", "obj", "ply", "xml", "gltf", "glb"];
+pub const SCENE_EXTENSIONS: [&str; 9] = [
+    "toml", "nff", "ray", "obj", "ply", "xml", "gltf", "glb", "pbrt",
+];
 
 /// Reads a scene file, choosing the format by extension: `.toml` (the native format), `.nff`
 /// (Haines' Neutral File Format), `.ray` (the course ray tracer's format), `.obj` and `.ply`
 /// (a mesh, framed by a default camera and lights), `.xml` (Mitsuba 3), `.gltf` and `.glb`
-/// (glTF 2.0); any other is refused. Relative paths
+/// (glTF 2.0), `.pbrt` (pbrt-v4); any other is refused. Relative paths
 /// inside are resolved against the file's folder.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
     let extension = path
@@ -129,7 +132,7 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
         };
         return Err(SceneError::file(
             path,
-            format!("not a scene file Plenum reads: {found}; the formats are .toml (native), .nff, .ray, .obj, .ply, .xml (Mitsuba 3), .gltf and .glb (glTF 2.0)"),
+            format!("not a scene file Plenum reads: {found}; the formats are .toml (native), .nff, .ray, .obj, .ply, .xml (Mitsuba 3), .gltf and .glb (glTF 2.0) and .pbrt (pbrt-v4)"),
         ));
     }
     let bytes = std::fs::read(path)
@@ -162,6 +165,14 @@ pub fn read_scene(path: &Path, extension: &str, bytes: Vec<u8>) -> Result<Loaded
                 scene: builder.build(),
                 defaults,
                 warnings: Vec::new(),
+            }
+        }
+        "pbrt" => {
+            let (builder, defaults, warnings) = pbrt::parse(path, text)?;
+            LoadedScene {
+                scene: builder.build(),
+                defaults,
+                warnings,
             }
         }
         "xml" => {

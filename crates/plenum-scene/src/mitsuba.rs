@@ -1177,11 +1177,9 @@ impl<'d> Builder<'d> {
         let position = m.point(Vec3::ZERO);
         let forward = m.vector(Vec3::Z).normalized();
         let up = m.vector(Vec3::Y).normalized();
-        let x = m.vector(Vec3::X);
-        if x.dot(up.cross(forward)) < 0.0 {
-            let l = ob.loc.clone();
-            self.warn(&l, "the sensor's to_world mirrors the image (x to the right of the view): Plenum renders it unmirrored");
-        }
+        // Mitsuba's image x runs along −x of the sensor's frame, which a look-at points to
+        // up × forward; a transform that turns it the other way mirrors the picture.
+        let left_handed = m.vector(Vec3::X).dot(up.cross(forward)) < 0.0;
         let fov = match (
             self.prop(o, "fov").is_some(),
             self.string(o, "focal_length")?,
@@ -1277,6 +1275,7 @@ impl<'d> Builder<'d> {
             up,
             fov_degrees: fov,
             lens,
+            left_handed,
             ..CameraSettings::default()
         };
         self.defaults.width = width;

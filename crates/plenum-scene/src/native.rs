@@ -272,6 +272,7 @@ impl<'s> Reader<'s> {
                 "shutter",
                 "position_close",
                 "look_at_close",
+                "left_handed",
             ],
         )?;
         let c = CameraSettings::default();
@@ -356,6 +357,7 @@ impl<'s> Reader<'s> {
             lens,
             shutter,
             motion,
+            left_handed: f.bool_or("left_handed", false)?,
         };
         Ok(())
     }

@@ -103,6 +103,9 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
     if let Some((p, l)) = c.motion {
         let _ = writeln!(w, "position_close = {}\nlook_at_close = {}", vec(p), vec(l));
     }
+    if c.left_handed {
+        let _ = writeln!(w, "left_handed = true");
+    }
     let _ = writeln!(w);
     // Objects that show an area light are written with their light.
     let mut shows_light: HashMap<u32, usize> = HashMap::new();

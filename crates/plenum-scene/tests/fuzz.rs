@@ -202,3 +202,54 @@ fn gltf_mutations() {
             read("gltf", &bytes);
         });
 }
+
+#[test]
+fn pbrt() {
+    bolero::check!().for_each(|bytes: &[u8]| read("pbrt", bytes));
+}
+
+/// pbrt-v4 statements of random directives, parameters and numbers: the graphics state's
+/// stack, transformations, named materials and objects, meshes with bad indices.
+#[test]
+fn pbrt_statements() {
+    const PIECES: &[&str] = &[
+        "AttributeBegin\n",
+        "AttributeEnd\n",
+        "Translate V V V\n",
+        "Scale V V V\n",
+        "Rotate V 0 1 0\n",
+        "LookAt 0 0 V  0 0 0  0 1 0\n",
+        "ConcatTransform [ V 0 0 0 0 V 0 0 0 0 V 0 0 0 0 1 ]\n",
+        "ReverseOrientation\n",
+        "Camera \"perspective\" \"float fov\" V\n",
+        "Film \"rgb\" \"integer xresolution\" V \"integer yresolution\" 8\n",
+        "WorldBegin\n",
+        "Material \"diffuse\" \"rgb reflectance\" [ V V V ]\n",
+        "MakeNamedMaterial \"m\" \"string type\" \"conductor\" \"float roughness\" V\n",
+        "NamedMaterial \"m\"\n",
+        "Texture \"t\" \"spectrum\" \"checkerboard\" \"float uscale\" V\n",
+        "Material \"coateddiffuse\" \"texture reflectance\" \"t\" \"float g\" V\n",
+        "AreaLightSource \"diffuse\" \"blackbody L\" V\n",
+        "LightSource \"spot\" \"float coneangle\" V \"point3 to\" [ V 0 1 ]\n",
+        "LightSource \"infinite\" \"rgb L\" [ V V V ]\n",
+        "Shape \"sphere\" \"float radius\" V\n",
+        "Shape \"disk\" \"float radius\" V\n",
+        "Shape \"cylinder\" \"float zmax\" V\n",
+        "Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 V 0 ] \"integer indices\" [ 0 1 V ]\n",
+        "Shape \"bilinearmesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 1 1 V ]\n",
+        "ObjectBegin \"o\"\n",
+        "ObjectEnd\n",
+        "ObjectInstance \"o\"\n",
+        "Include \"other.pbrt\"\n",
+    ];
+    bolero::check!()
+        .with_type::<Vec<(u8, i16)>>()
+        .for_each(|items| {
+            let mut text = String::new();
+            for (piece, v) in items {
+                let value = format!("{}", *v as f64 / 100.0);
+                text.push_str(&PIECES[*piece as usize % PIECES.len()].replace('V', &value));
+            }
+            read("pbrt", text.as_bytes());
+        });
+}

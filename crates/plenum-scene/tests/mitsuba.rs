@@ -220,11 +220,11 @@ fn transforms_compose_in_the_order_written() {
 fn the_camera_keeps_mitsubas_handedness() {
     // Mitsuba's look-at frame has +x to the left of the view: looking along +z with +y up,
     // a lamp at x = +1 appears in the image's left half, one at y = +1 in its top half.
-    let picture = |x: f64, y: f64| {
+    let picture = |x: f64, y: f64, mirror: &str| {
         let l = load(&scene(&format!(
             r#"<sensor type="perspective">
                 <float name="fov" value="60"/>
-                <transform name="to_world"><lookat origin="0 0 0" target="0 0 1" up="0 1 0"/></transform>
+                <transform name="to_world">{mirror}<lookat origin="0 0 0" target="0 0 1" up="0 1 0"/></transform>
                 <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/></film>
             </sensor>
             <shape type="sphere"><point name="center" x="{x}" y="{y}" z="4"/><float name="radius" value="0.5"/>
@@ -242,15 +242,21 @@ fn the_camera_keeps_mitsubas_handedness() {
         assert!(n > 0.0, "the lamp is seen");
         (sx / n, sy / n)
     };
-    let (x, y) = picture(1.0, 0.0);
+    let (x, y) = picture(1.0, 0.0, "");
     assert!(
         x < 12.0 && (y - 15.5).abs() < 2.0,
         "a lamp at +x lands at ({x}, {y})"
     );
-    let (x, y) = picture(0.0, 1.0);
+    let (x, y) = picture(0.0, 1.0, "");
     assert!(
         (x - 15.5).abs() < 2.0 && y < 12.0,
         "a lamp at +y lands at ({x}, {y})"
+    );
+    // A sensor frame mirrored in its own x: the mirror image, as Mitsuba renders it.
+    let (x, y) = picture(1.0, 0.0, r#"<scale x="-1"/>"#);
+    assert!(
+        x > 20.0 && (y - 15.5).abs() < 2.0,
+        "mirrored, a lamp at +x lands at ({x}, {y})"
     );
 }
 
@@ -397,6 +403,11 @@ fn errors_name_the_line_and_column() {
         <shape type="sphere"><ref id="loop"/></shape>"#,
     ));
     assert!(e.message.contains("contains itself"), "{e}");
+
+    let e = error(&scene(
+        r#"<include filename="scene.xml"/><include filename="scene.xml"/>"#,
+    ));
+    assert!(e.message.contains("includes itself"), "{e}");
 
     let e = error(&scene(r#"<include filename="missing.xml"/>"#));
     assert!(e.message.contains("cannot read the included file"), "{e}");

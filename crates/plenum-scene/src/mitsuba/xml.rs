@@ -13,8 +13,10 @@ use std::collections::HashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-/// The deepest `<include>` chain (a file that includes itself stops here).
+/// The deepest `<include>` chain, and the most files a scene may read (a file that includes
+/// another twice, which includes another twice, … would otherwise read 2^depth files).
 const MAX_INCLUDE_DEPTH: usize = 32;
+const MAX_FILES: usize = 4096;
 /// The most XML nodes a file may hold (far beyond any scene; bounds memory on bad input).
 const MAX_NODES: u32 = 10_000_000;
 
@@ -147,6 +149,7 @@ impl Document {
             },
             params: Vec::new(),
             include_depth: 0,
+            include_stack: Vec::new(),
         };
         parser.file(path.to_path_buf(), text, None, 0)?;
         if parser.doc.objects.first().map(|o| o.tag.as_str()) != Some("scene") {
@@ -220,6 +223,8 @@ struct Parser {
     params: Vec<(String, String)>,
     /// How many `<include>`s deep the file being read is.
     include_depth: usize,
+    /// The files including the one being read, to refuse one that includes itself.
+    include_stack: Vec<Option<PathBuf>>,
 }
 
 /// An element's attributes after substitution, with where each value was written.
@@ -547,7 +552,23 @@ impl Parser {
                 if self.include_depth >= MAX_INCLUDE_DEPTH {
                     return Err(self.doc.error(
                         &self.loc(ctx.file, span),
-                        format!("includes nested deeper than {MAX_INCLUDE_DEPTH} files (does a file include itself?)"),
+                        format!("includes nested deeper than {MAX_INCLUDE_DEPTH} files"),
+                    ));
+                }
+                if self.doc.sources.len() >= MAX_FILES {
+                    return Err(self.doc.error(
+                        &self.loc(ctx.file, span),
+                        format!("more than {MAX_FILES} files included"),
+                    ));
+                }
+                let canonical = std::fs::canonicalize(&path).ok();
+                let own = std::fs::canonicalize(&self.doc.sources[ctx.file].path).ok();
+                if canonical.is_some()
+                    && (canonical == own || self.include_stack.contains(&canonical))
+                {
+                    return Err(self.doc.error(
+                        &self.loc(ctx.file, span),
+                        format!("{} includes itself", path.display()),
                     ));
                 }
                 let bytes = std::fs::read(&path).map_err(|e| {
@@ -558,8 +579,10 @@ impl Parser {
                 })?;
                 let (text, _) = crate::text::lenient(&path, bytes);
                 self.include_depth += 1;
+                self.include_stack.push(own);
                 let name = attrs.get("name").map(|(n, _)| n.to_string());
                 let r = self.file(path, text, Some((parent, name)), depth + 1);
+                self.include_stack.pop();
                 self.include_depth -= 1;
                 return r;
             }
