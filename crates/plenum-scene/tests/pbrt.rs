@@ -5,8 +5,8 @@
 
 mod common;
 
-use common::integrators::{draw, path_settings};
-use plenum_core::integrator::ColorMode;
+use common::integrators::{cbox_z_test_of, draw, path_settings};
+use plenum_core::integrator::{ColorMode, IntegratorKind};
 use plenum_scene::{load_scene, to_toml, LoadedScene, SceneError};
 use std::path::PathBuf;
 use toml::{Table, Value};
@@ -332,4 +332,78 @@ fn the_breakfast_room_renders_as_its_file_says() {
     assert!(t["objects"].as_array().unwrap().len() >= 50);
     // The sun and the sky dome.
     assert_eq!(t["lights"].as_array().unwrap().len(), 2);
+}
+
+fn cbox() -> LoadedScene {
+    let file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/references/cbox.pbrt");
+    load_scene(&file).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The Cornell box in pbrt's format (tests/references/cbox.pbrt) reads as
+/// scenes/cornell-box.toml: the same meshes, reflectances, light, camera and settings (pbrt's
+/// materials are two-sided, Mitsuba's one-sided: inside the box no back face is seen).
+#[test]
+fn a_cornell_box_in_pbrts_format_reads_as_the_native_one() {
+    let l = cbox();
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    let native_box = common::integrators::load_cornell_box();
+    let (a, b) = (native(&l), native(&native_box));
+    // Each object's triangles as their corners (the meshes may number vertices apart), its
+    // emission and reflectance.
+    type Triangles = Vec<[[u64; 3]; 3]>;
+    let objects = |t: &Table| -> Vec<(Triangles, Option<Value>, Value)> {
+        t["objects"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|o| {
+                let p = o["positions"].as_array().unwrap();
+                let corner = |i: &Value| -> [u64; 3] {
+                    let v = p[i.as_integer().unwrap() as usize].as_array().unwrap();
+                    [0, 1, 2].map(|k| number(&v[k]).to_bits())
+                };
+                let mut triangles: Triangles = o["indices"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|t| {
+                        let t = t.as_array().unwrap();
+                        [corner(&t[0]), corner(&t[1]), corner(&t[2])]
+                    })
+                    .collect();
+                triangles.sort();
+                let m = &t["materials"][o["material"].as_str().unwrap()];
+                (
+                    triangles,
+                    o.get("emission").cloned(),
+                    m["reflectance"].clone(),
+                )
+            })
+            .collect()
+    };
+    assert_eq!(objects(&a), objects(&b));
+    for key in ["position", "look_at", "up", "fov", "resolution"] {
+        assert_eq!(a["camera"][key], b["camera"][key], "{key}");
+    }
+    // `Scale -1 1 1` before the LookAt undoes pbrt's left-handed camera space.
+    assert!(a["camera"].get("left_handed").is_none());
+    let (d, e) = (&l.defaults, &native_box.defaults);
+    assert_eq!(
+        (d.spp, d.max_depth, d.filter),
+        (e.spp, e.max_depth, e.filter)
+    );
+}
+
+#[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
+fn a_cornell_box_in_pbrts_format_matches_mitsubas_render() {
+    cbox_z_test_of(
+        &cbox(),
+        IntegratorKind::Path,
+        ColorMode::Rgb,
+        "reference.exr",
+        "reference-variance.exr",
+        16,
+        |_| {},
+    );
 }

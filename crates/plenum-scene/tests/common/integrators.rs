@@ -163,17 +163,37 @@ pub fn cbox_z_test_with(
     spp: u32,
     tweak: impl Fn(&mut RenderSettings),
 ) {
+    cbox_z_test_of(
+        &load_cornell_box(),
+        kind,
+        color,
+        reference,
+        variance,
+        spp,
+        tweak,
+    );
+}
+
+/// [`cbox_z_test_with`] of the Cornell box as another file describes it (another format).
+pub fn cbox_z_test_of(
+    l: &LoadedScene,
+    kind: IntegratorKind,
+    color: ColorMode,
+    reference: &str,
+    variance: &str,
+    spp: u32,
+    tweak: impl Fn(&mut RenderSettings),
+) {
     let (Some(r), Some(v)) = (cbox_reference(reference), cbox_reference(variance)) else {
         return;
     };
     let (reference, ref_var) = (read_exr(&r), read_exr(&v));
-    let l = load_cornell_box();
     let renders = 16u64;
     let images: Vec<Vec<[f32; 3]>> = (0..renders)
         .map(|seed| {
-            let mut s = settings_for(&l, kind, spp, color, 1000 + seed);
+            let mut s = settings_for(l, kind, spp, color, 1000 + seed);
             tweak(&mut s);
-            draw(&l, &s)
+            draw(l, &s)
         })
         .collect();
     assert_eq!(images[0].len(), reference.len());
