@@ -350,7 +350,7 @@ impl<'d> Builder<'d> {
                 .error(&p.loc, format!("expected a texture, found a <{}>", ob.tag)));
         }
         self.read.push(t);
-        let (scale, loc) = self.uv_scale(t)?;
+        let scale = self.uv_scale(t)?;
         match ob.plugin.as_str() {
             "bitmap" => {
                 let (file, floc) = self
@@ -380,7 +380,6 @@ impl<'d> Builder<'d> {
                 Ok(Texture::Image(Arc::new(image)))
             }
             "checkerboard" => {
-                let _ = loc;
                 // Mitsuba: color0 where u and v are on the same side of ½ in each unit
                 // square, Plenum's even squares at twice the frequency.
                 let even = self.color(t, "color0", 0.4)?;
@@ -401,9 +400,9 @@ impl<'d> Builder<'d> {
     }
 
     /// A texture's `to_uv` as repeats in u and v (scale only; anything else warns).
-    fn uv_scale(&mut self, t: usize) -> Result<([f64; 2], Option<Loc>)> {
+    fn uv_scale(&mut self, t: usize) -> Result<[f64; 2]> {
         let Some(p) = self.prop(t, "to_uv") else {
-            return Ok(([1.0, 1.0], None));
+            return Ok([1.0, 1.0]);
         };
         let Value::Transform(m) = &p.value else {
             return Err(self.doc.expected(p, "a transform"));
@@ -417,10 +416,7 @@ impl<'d> Builder<'d> {
                 "`to_uv`: only a positive scale of u and v is supported; its rotation, offset or mirroring is ignored",
             );
         }
-        Ok((
-            [su.abs().max(1e-9), sv.abs().max(1e-9)],
-            Some(p.loc.clone()),
-        ))
+        Ok([su.abs().max(1e-9), sv.abs().max(1e-9)])
     }
 
     /// A roughness α: a float or a texture.

@@ -174,13 +174,9 @@ struct Parser {
     include_stack: Vec<Option<PathBuf>>,
 }
 
-fn matrix_identity() -> Matrix4 {
-    Matrix4::IDENTITY
-}
-
 impl Parser {
     fn ctm(&self) -> Matrix4 {
-        self.state.ctm.unwrap_or_else(matrix_identity)
+        self.state.ctm.unwrap_or(Matrix4::IDENTITY)
     }
 
     fn error(&self, loc: &Loc, message: impl Into<String>) -> SceneError {
@@ -1189,7 +1185,10 @@ impl Parser {
             self.positive(p, "yradius", default)?,
         );
         if x != y {
-            let l = p.get("yradius").unwrap().loc.clone();
+            let l = p
+                .get("yradius")
+                .or(p.get("xradius"))
+                .map_or(loc.clone(), |q| q.loc.clone());
             self.warn(
                 &l,
                 "Plenum's filters are round: using xradius for both axes",

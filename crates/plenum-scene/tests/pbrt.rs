@@ -279,6 +279,16 @@ fn errors_and_warnings_are_located() {
     let e = error("Include \"scene.pbrt\"\nInclude \"scene.pbrt\"\n");
     assert!(e.message.contains("includes itself"), "{e}");
 
+    // A filter given one radius: the other keeps the filter's own, and round filters say so.
+    let l = load(
+        "PixelFilter \"triangle\" \"float xradius\" 1\nWorldBegin\nLightSource \"infinite\"\n",
+    );
+    assert!(
+        l.warnings.len() == 1 && l.warnings[0].contains("round"),
+        "{:?}",
+        l.warnings
+    );
+
     let e = error("WorldBegin\nAttributeEnd\n");
     assert!(e.message.contains("without a matching begin"), "{e}");
 
