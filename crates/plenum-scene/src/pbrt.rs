@@ -184,6 +184,21 @@ impl Parser {
         SceneError::at(&s.path, &s.text, loc.span.clone(), message)
     }
 
+    /// A path written in file `file`, relative to that file's folder.
+    fn path_in(&self, file: usize, name: &str) -> PathBuf {
+        let base = self.sources[file].path.parent().unwrap_or(Path::new("."));
+        base.join(name)
+    }
+
+    /// "unknown `what` `name`", with the nearest of `known` suggested.
+    fn unknown(&self, loc: &Loc, what: &str, name: &str, known: &[&str]) -> SceneError {
+        let e = self.error(loc, format!("unknown {what} `{name}`"));
+        match did_you_mean(name, known.iter().copied()) {
+            Some(s) => e.with_help(format!("did you mean `{s}`?")),
+            None => e,
+        }
+    }
+
     fn warn(&mut self, loc: &Loc, message: impl Into<String>) {
         let w = self.error(loc, message).as_warning();
         self.warnings.push(w);
@@ -1007,12 +1022,7 @@ impl Parser {
                 if self.sources.len() >= MAX_FILES {
                     return Err(self.error(loc, format!("more than {MAX_FILES} files included")));
                 }
-                let base = self.sources[loc.file]
-                    .path
-                    .parent()
-                    .unwrap_or(Path::new("."))
-                    .to_path_buf();
-                let path = base.join(&name);
+                let path = self.path_in(loc.file, &name);
                 let canonical = std::fs::canonicalize(&path).ok();
                 if canonical.is_some() && self.include_stack.contains(&canonical) {
                     return Err(self.error(loc, format!("{} includes itself", path.display())));
@@ -1070,11 +1080,7 @@ impl Parser {
                     "MakeNamedMedium",
                     "MediumInterface",
                 ];
-                let e = self.error(loc, format!("unknown directive `{other}`"));
-                return Err(match did_you_mean(other, ALL.iter().copied()) {
-                    Some(s) => e.with_help(format!("did you mean `{s}`?")),
-                    None => e,
-                });
+                return Err(self.unknown(loc, "directive", other, ALL));
             }
         }
         self.report_unused(d, &name_of_type, &params);
@@ -1476,12 +1482,7 @@ impl Parser {
                 let Some((file, floc)) = self.string(p, "filename")? else {
                     return Err(self.error(loc, "an imagemap needs a \"string filename\""));
                 };
-                let base = self.sources[floc.file]
-                    .path
-                    .parent()
-                    .unwrap_or(Path::new("."))
-                    .to_path_buf();
-                let path = base.join(file);
+                let path = self.path_in(floc.file, file);
                 let scale_uv = mapping(self)?;
                 let scale = self.float(p, "scale", 1.0)?;
                 let invert = self.boolean_param(p, "invert", false)?;
@@ -1695,12 +1696,7 @@ impl Parser {
                             let l = q.loc.clone();
                             self.warn(&l, "`illuminance` with an image is not supported: the image's own values are used");
                         }
-                        let base = self.sources[floc.file]
-                            .path
-                            .parent()
-                            .unwrap_or(Path::new("."))
-                            .to_path_buf();
-                        let path = base.join(file);
+                        let path = self.path_in(floc.file, file);
                         let image = plenum_image::read_float_image(&path)
                             .map_err(|e| self.error(&floc, e.to_string()))?;
                         let scale = self.float(p, "scale", 1.0)?.max(0.0);
@@ -1745,23 +1741,19 @@ impl Parser {
                 return Ok(());
             }
             other => {
-                let e = self.error(loc, format!("unknown light `{other}`"));
-                return Err(
-                    match did_you_mean(
-                        other,
-                        [
-                            "point",
-                            "spot",
-                            "distant",
-                            "infinite",
-                            "goniometric",
-                            "projection",
-                        ],
-                    ) {
-                        Some(s) => e.with_help(format!("did you mean `{s}`?")),
-                        None => e,
-                    },
-                );
+                return Err(self.unknown(
+                    loc,
+                    "light",
+                    other,
+                    &[
+                        "point",
+                        "spot",
+                        "distant",
+                        "infinite",
+                        "goniometric",
+                        "projection",
+                    ],
+                ));
             }
         };
         self.builder.add_light(name, light);
@@ -1910,12 +1902,7 @@ impl Parser {
                 let Some((file, floc)) = self.string(p, "filename")? else {
                     return Err(self.error(loc, "a plymesh needs a \"string filename\""));
                 };
-                let base = self.sources[floc.file]
-                    .path
-                    .parent()
-                    .unwrap_or(Path::new("."))
-                    .to_path_buf();
-                let path = base.join(file);
+                let path = self.path_in(floc.file, file);
                 let bytes = std::fs::read(&path).map_err(|e| {
                     self.error(&floc, format!("cannot read {}: {e}", path.display()))
                 })?;
@@ -1953,25 +1940,21 @@ impl Parser {
                 return Ok(());
             }
             other => {
-                let e = self.error(loc, format!("unknown shape `{other}`"));
-                return Err(
-                    match did_you_mean(
-                        other,
-                        [
-                            "sphere",
-                            "disk",
-                            "cylinder",
-                            "trianglemesh",
-                            "bilinearmesh",
-                            "loopsubdiv",
-                            "plymesh",
-                            "curve",
-                        ],
-                    ) {
-                        Some(s) => e.with_help(format!("did you mean `{s}`?")),
-                        None => e,
-                    },
-                );
+                return Err(self.unknown(
+                    loc,
+                    "shape",
+                    other,
+                    &[
+                        "sphere",
+                        "disk",
+                        "cylinder",
+                        "trianglemesh",
+                        "bilinearmesh",
+                        "loopsubdiv",
+                        "plymesh",
+                        "curve",
+                    ],
+                ));
             }
         };
         for key in ["alpha", "emissionfilename"] {

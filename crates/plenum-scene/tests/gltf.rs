@@ -4,10 +4,12 @@
 
 mod common;
 
+use common::{bright_centre, load_files, native, number};
+
 use common::integrators::{draw, path_settings};
 use plenum_core::integrator::ColorMode;
-use plenum_scene::{load_scene, to_toml, LoadedScene, SceneError};
-use toml::{Table, Value};
+use plenum_scene::LoadedScene;
+use toml::Table;
 
 fn base64(bytes: &[u8]) -> String {
     const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -72,26 +74,8 @@ fn data_uri() -> String {
     format!("data:application/octet-stream;base64,{}", base64(&square()))
 }
 
-fn load_files(files: &[(&str, &[u8])]) -> Result<LoadedScene, SceneError> {
-    let dir = tempfile::tempdir().unwrap();
-    for (name, bytes) in files {
-        std::fs::write(dir.path().join(name), bytes).unwrap();
-    }
-    load_scene(&dir.path().join(files[0].0))
-}
-
 fn load(text: &str) -> LoadedScene {
     load_files(&[("scene.gltf", text.as_bytes())]).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn native(l: &LoadedScene) -> Table {
-    to_toml(&l.scene, &l.defaults).parse().unwrap()
-}
-
-fn number(v: &Value) -> f64 {
-    v.as_float()
-        .or_else(|| v.as_integer().map(|i| i as f64))
-        .unwrap()
 }
 
 const GREY: &str =
@@ -148,16 +132,7 @@ fn the_camera_looks_down_minus_z_with_x_to_the_right() {
         l.defaults.width = 32;
         l.defaults.height = 32;
         let image = draw(&l, &path_settings(&l, 1, ColorMode::Rgb, 3));
-        let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
-        for (i, p) in image.iter().enumerate() {
-            if p[0] > 0.5 {
-                sx += (i % 32) as f64;
-                sy += (i / 32) as f64;
-                n += 1.0;
-            }
-        }
-        assert!(n > 0.0, "the square is seen");
-        (sx / n, sy / n)
+        bright_centre(&image, 32)
     };
     let (x, y) = picture(1.2, 0.0);
     assert!(

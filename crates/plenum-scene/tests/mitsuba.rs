@@ -4,35 +4,23 @@
 
 mod common;
 
+use common::{bright_centre, load_files, native, number};
+
 use common::integrators::{draw, path_settings};
 use plenum_core::integrator::ColorMode;
-use plenum_scene::{load_scene, to_toml, LoadedScene, SceneError};
+use plenum_scene::{load_scene, LoadedScene, SceneError};
 use std::path::{Path, PathBuf};
 use toml::{Table, Value};
 
-/// Writes `files` (name, text) into a fresh folder and loads the first.
-fn load_files(files: &[(&str, &str)]) -> Result<LoadedScene, SceneError> {
-    let dir = tempfile::tempdir().unwrap();
-    for (name, text) in files {
-        std::fs::write(dir.path().join(name), text).unwrap();
-    }
-    load_scene(&dir.path().join(files[0].0))
-}
-
 fn load(text: &str) -> LoadedScene {
-    load_files(&[("scene.xml", text)]).unwrap_or_else(|e| panic!("{e}"))
+    load_files(&[("scene.xml", text.as_bytes())]).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn error(text: &str) -> SceneError {
-    match load_files(&[("scene.xml", text)]) {
+    match load_files(&[("scene.xml", text.as_bytes())]) {
         Ok(_) => panic!("expected an error"),
         Err(e) => e,
     }
-}
-
-/// The scene as the native format writes it, parsed.
-fn native(l: &LoadedScene) -> Table {
-    to_toml(&l.scene, &l.defaults).parse().unwrap()
 }
 
 fn scene(body: &str) -> String {
@@ -50,12 +38,6 @@ fn lit(body: &str) -> String {
 fn material_of(t: &Table, i: usize) -> &Table {
     let name = t["objects"][i]["material"].as_str().unwrap();
     t["materials"][name].as_table().unwrap()
-}
-
-fn number(v: &Value) -> f64 {
-    v.as_float()
-        .or_else(|| v.as_integer().map(|i| i as f64))
-        .unwrap()
 }
 
 /// Whether two written scenes agree: numbers within 1e-6 (relative), files by their
@@ -157,8 +139,8 @@ fn defaults_substitutions_includes_and_forward_references() {
     let more = scene(
         r#"<shape type="disk" id="floor"><bsdf type="twosided"><bsdf type="diffuse"/></bsdf></shape>"#,
     );
-    let l =
-        load_files(&[("main.xml", &main), ("more.xml", &more)]).unwrap_or_else(|e| panic!("{e}"));
+    let l = load_files(&[("main.xml", main.as_bytes()), ("more.xml", more.as_bytes())])
+        .unwrap_or_else(|e| panic!("{e}"));
     let t = native(&l);
     let objects = t["objects"].as_array().unwrap();
     assert_eq!(objects.len(), 2);
@@ -231,16 +213,7 @@ fn the_camera_keeps_mitsubas_handedness() {
                 <emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>"#
         )));
         let image = draw(&l, &path_settings(&l, 1, ColorMode::Rgb, 7));
-        let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
-        for (i, p) in image.iter().enumerate() {
-            if p[0] > 0.5 {
-                sx += (i % 32) as f64;
-                sy += (i / 32) as f64;
-                n += 1.0;
-            }
-        }
-        assert!(n > 0.0, "the lamp is seen");
-        (sx / n, sy / n)
+        bright_centre(&image, 32)
     };
     let (x, y) = picture(1.0, 0.0, "");
     assert!(

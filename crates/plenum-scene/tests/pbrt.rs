@@ -5,39 +5,23 @@
 
 mod common;
 
+use common::{bright_centre, load_files, native, number};
+
 use common::integrators::{cbox_z_test_of, draw, path_settings};
 use plenum_core::integrator::{ColorMode, IntegratorKind};
-use plenum_scene::{load_scene, to_toml, LoadedScene, SceneError};
+use plenum_scene::{load_scene, LoadedScene, SceneError};
 use std::path::PathBuf;
 use toml::{Table, Value};
 
-fn load_files(files: &[(&str, &str)]) -> Result<LoadedScene, SceneError> {
-    let dir = tempfile::tempdir().unwrap();
-    for (name, text) in files {
-        std::fs::write(dir.path().join(name), text).unwrap();
-    }
-    load_scene(&dir.path().join(files[0].0))
-}
-
 fn load(text: &str) -> LoadedScene {
-    load_files(&[("scene.pbrt", text)]).unwrap_or_else(|e| panic!("{e}"))
+    load_files(&[("scene.pbrt", text.as_bytes())]).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn error(text: &str) -> SceneError {
-    match load_files(&[("scene.pbrt", text)]) {
+    match load_files(&[("scene.pbrt", text.as_bytes())]) {
         Ok(_) => panic!("expected an error"),
         Err(e) => e,
     }
-}
-
-fn native(l: &LoadedScene) -> Table {
-    to_toml(&l.scene, &l.defaults).parse().unwrap()
-}
-
-fn number(v: &Value) -> f64 {
-    v.as_float()
-        .or_else(|| v.as_integer().map(|i| i as f64))
-        .unwrap()
 }
 
 /// A camera at the origin looking down +z, 32 × 32 pixels, 1 sample.
@@ -98,16 +82,7 @@ AttributeEnd
 "#
         ));
         let image = draw(&l, &path_settings(&l, 1, ColorMode::Rgb, 1));
-        let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
-        for (i, p) in image.iter().enumerate() {
-            if p[0] > 0.5 {
-                sx += (i % 32) as f64;
-                sy += (i / 32) as f64;
-                n += 1.0;
-            }
-        }
-        assert!(n > 0.0, "the lamp is seen");
-        (sx / n, sy / n)
+        bright_centre(&image, 32)
     };
     let (x, y) = picture(1.0, 0.0);
     assert!(
@@ -177,8 +152,11 @@ ObjectInstance "pair"
 Include "more.pbrt"
 "#;
     let more = "NamedMaterial \"glass\"\nShape \"sphere\" \"float radius\" 3\n";
-    let l =
-        load_files(&[("scene.pbrt", main), ("more.pbrt", more)]).unwrap_or_else(|e| panic!("{e}"));
+    let l = load_files(&[
+        ("scene.pbrt", main.as_bytes()),
+        ("more.pbrt", more.as_bytes()),
+    ])
+    .unwrap_or_else(|e| panic!("{e}"));
     assert!(l.warnings.is_empty(), "{:?}", l.warnings);
     let t = native(&l);
     let objects = t["objects"].as_array().unwrap();

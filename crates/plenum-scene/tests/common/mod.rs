@@ -25,3 +25,47 @@ pub fn missing(what: &str) {
     }
     eprintln!("{what} is not here: this test has nothing to compare with");
 }
+
+/// Writes `files` (name, bytes) into a fresh folder and loads the first as a scene.
+#[allow(dead_code)]
+pub fn load_files(
+    files: &[(&str, &[u8])],
+) -> Result<plenum_scene::LoadedScene, plenum_scene::SceneError> {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, bytes) in files {
+        std::fs::write(dir.path().join(name), bytes).unwrap();
+    }
+    plenum_scene::load_scene(&dir.path().join(files[0].0))
+}
+
+/// The scene as `plenum convert` writes it, parsed back.
+#[allow(dead_code)]
+pub fn native(l: &plenum_scene::LoadedScene) -> toml::Table {
+    plenum_scene::to_toml(&l.scene, &l.defaults)
+        .parse()
+        .unwrap()
+}
+
+/// A written number, integer or float.
+#[allow(dead_code)]
+pub fn number(v: &toml::Value) -> f64 {
+    v.as_float()
+        .or_else(|| v.as_integer().map(|i| i as f64))
+        .unwrap()
+}
+
+/// Where a lamp lands: the mean position of the pixels of `image` (`width` wide) whose red
+/// exceeds 0.5. Panics if there are none.
+#[allow(dead_code)]
+pub fn bright_centre(image: &[[f32; 3]], width: usize) -> (f64, f64) {
+    let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+    for (i, p) in image.iter().enumerate() {
+        if p[0] > 0.5 {
+            sx += (i % width) as f64;
+            sy += (i / width) as f64;
+            n += 1.0;
+        }
+    }
+    assert!(n > 0.0, "the lamp is seen");
+    (sx / n, sy / n)
+}
