@@ -875,3 +875,75 @@ material = "ball"
         }
     }
 }
+
+/// Phong glass (glossy and refracting) and a Phong mirror with a highlight, over a floor
+/// under a sky: photon mapping (64 spp, its default maps) within 4 % of a 2048-spp path
+/// trace, per channel, and SPPM (4096 iterations of 4000 photons) within 2 % (RGB, seed 7;
+/// 24×24 pixels; measured −2.4 % and +0.1 %). Before, both methods stopped the eye path
+/// at the first surface with a diffuse or glossy lobe and lost the specular lobes there:
+/// −22 % and −27 %.
+#[test]
+fn phong_glass_and_mirrors_are_read_alike_by_every_method() {
+    let l = scene(
+        r#"
+background = [0.6, 0.7, 0.9]
+[render]
+max_depth = 5
+[camera]
+position = [0, 1.2, 4]
+look_at = [0, 0.7, 0]
+fov = 35
+resolution = [24, 24]
+[materials.floor]
+type = "diffuse"
+reflectance = [0.7, 0.6, 0.5]
+[materials.glass]
+diffuse = 0.0
+specular = 0.6
+shininess = 200
+transmissive = 0.95
+ior = 1.5
+fresnel = true
+[materials.mirror]
+diffuse = [0.05, 0.05, 0.06]
+specular = 0.5
+shininess = 120
+reflective = 0.85
+[[objects]]
+type = "polygon"
+material = "floor"
+vertices = [[-6, 0, -6], [-6, 0, 6], [6, 0, 6], [6, 0, -6]]
+[[objects]]
+type = "sphere"
+center = [0.55, 0.6, 0]
+radius = 0.6
+material = "glass"
+[[objects]]
+type = "sphere"
+center = [-0.6, 0.6, -0.6]
+radius = 0.6
+material = "mirror"
+"#,
+    );
+    let reference = mean(&draw(
+        &l,
+        &settings_for(&l, IntegratorKind::Path, 2048, ColorMode::Rgb, 7),
+    ));
+    let photon = settings_for(&l, IntegratorKind::Photon, 64, ColorMode::Rgb, 7);
+    let mut sppm = settings_for(&l, IntegratorKind::Sppm, 4096, ColorMode::Rgb, 7);
+    sppm.integrator.photon.sppm_photons = 4000;
+    for (settings, tolerance) in [(photon, 0.04), (sppm, 0.02)] {
+        let m = mean(&draw(&l, &settings));
+        for c in 0..3 {
+            let rel = m[c] / reference[c] - 1.0;
+            assert!(
+                rel.abs() < tolerance,
+                "{}: channel {c} {:.4} against the path tracer's {:.4} ({:+.2} %)",
+                settings.integrator.kind.name(),
+                m[c],
+                reference[c],
+                100.0 * rel
+            );
+        }
+    }
+}

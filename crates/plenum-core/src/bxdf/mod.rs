@@ -238,6 +238,26 @@ impl Bxdf {
         }
     }
 
+    /// Roughly the share of the light leaving toward `wo` that comes by the diffuse and
+    /// glossy lobes rather than the specular ones, in [0, 1]: 1 without a specular lobe, 0
+    /// with only specular ones. A method that must choose between the two kinds at one
+    /// vertex (SPPM keeps one visible point per pixel) chooses by it; any value strictly
+    /// between 0 and 1 keeps its estimate unbiased, a good one keeps the variance low.
+    pub fn non_specular_fraction(&self, wo: Vec3) -> f64 {
+        let flags = self.flags();
+        if !flags.is_specular() {
+            return 1.0;
+        }
+        if !flags.is_non_specular() {
+            return 0.0;
+        }
+        match self {
+            Bxdf::Phong(b) => b.non_specular_fraction(wo),
+            Bxdf::CoatedDiffuse(b) => b.non_specular_fraction(wo),
+            _ => 0.5,
+        }
+    }
+
     pub fn flags(&self) -> BxdfFlags {
         match self {
             Bxdf::Diffuse(b) => b.flags(),
@@ -295,6 +315,11 @@ impl Bsdf {
 
     pub fn flags(&self) -> BxdfFlags {
         self.bxdf.flags()
+    }
+
+    /// [`Bxdf::non_specular_fraction`] toward the world direction `wo`.
+    pub fn non_specular_fraction(&self, wo_world: Vec3) -> f64 {
+        self.bxdf.non_specular_fraction(self.to_local(wo_world))
     }
 
     pub fn f(&self, wo_world: Vec3, wi_world: Vec3, mode: TransportMode) -> SampledSpectrum {

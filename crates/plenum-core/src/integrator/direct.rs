@@ -132,7 +132,8 @@ pub(super) fn bsdf_pdf(bsdf: &Bsdf, wo: Vec3, bs: &crate::bxdf::BsdfSample) -> f
 /// go on from `it` (SPPM's visible point, the path tracer's last vertex): the emitter or
 /// infinite light it finds, weighed against one light sample, and in full what light
 /// sampling cannot find: the background, a Phong surface's k_e, and whatever a specular
-/// lobe's direction meets.
+/// lobe's direction meets (unless `specular` is false: a path that also goes on through
+/// the specular lobes finds that light there, and a specular sample here counts nothing).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn bsdf_sample_ld(
     scene: &Scene,
@@ -143,11 +144,15 @@ pub(super) fn bsdf_sample_ld(
     stream: &mut SampleStream,
     counts: &mut RayCounts,
     time: f64,
+    specular: bool,
 ) -> SampledSpectrum {
     let (uc, u) = (stream.next_1d(), stream.next_2d());
     let Some(bs) = bsdf.sample_f(wo, uc, u, TransportMode::Radiance) else {
         return SampledSpectrum::ZERO;
     };
+    if bs.is_specular() && !specular {
+        return SampledSpectrum::ZERO;
+    }
     let beta = bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
     if beta.is_black() {
         return SampledSpectrum::ZERO;

@@ -150,7 +150,9 @@ impl<'a> PathTracer<'a> {
                 // emitter, the sky, light seen in a mirror), but the path ends here (as
                 // pbrt-v4's and Mitsuba's path tracers count depth).
                 l += beta
-                    * direct::bsdf_sample_ld(scene, &it, wo, &bsdf, wl, stream, counts, ray.time);
+                    * direct::bsdf_sample_ld(
+                        scene, &it, wo, &bsdf, wl, stream, counts, ray.time, true,
+                    );
                 record(&mut tree, node, |n| {
                     n.color = added(l, wl);
                     n.stops.push(Stop::Depth);

@@ -7,7 +7,9 @@
 //! - caustics, the caustic map's density estimate at that point;
 //! - indirect light, by final gathering: `gather_rays` rays sampled from the BSDF, each
 //!   taking the global map's density estimate at its first diffuse or glossy hit (after
-//!   any specular bounces) as the radiance it brings back.
+//!   any specular bounces) as the radiance it brings back. A hit that also has specular
+//!   lobes (Phong glass, a mirror with a highlight) adds the estimate, for its diffuse and
+//!   glossy lobes, and goes on where its BSDF sample is specular, for the rest.
 //!
 //! A density estimate is Σ f(ωo, ωp)·Φp / (π r²) over the k nearest photons facing the same
 //! way, r the distance of the (k + 1)-th (which makes k/(π r²) an unbiased density for
@@ -161,7 +163,12 @@ impl<'a> PhotonMapper<'a> {
             let Some(bsdf) = scene.bsdf(&it, wo, wl) else {
                 break;
             };
-            if bsdf.flags().is_non_specular() {
+            let flags = bsdf.flags();
+            // A surface with both kinds of lobe (Phong glass, a mirror with a highlight) is
+            // gathered for its diffuse and glossy lobes, and the eye path goes on through its
+            // specular ones, so that what they show is seen as sharply as through pure glass.
+            let goes_on = flags.is_specular() && e <= self.max_depth;
+            if flags.is_non_specular() {
                 let time = ray.time;
                 // The gather rays are the BSDF samples MIS weighs the light sample against.
                 let n = if e <= self.max_depth {
@@ -184,11 +191,14 @@ impl<'a> PhotonMapper<'a> {
                         })
                     });
                 }
-                let gathered =
-                    self.gather(&it, wo, &bsdf, wl, stream, counts, e, time, &mut tree, node);
+                let gathered = self.gather(
+                    &it, wo, &bsdf, wl, stream, counts, e, time, !goes_on, &mut tree, node,
+                );
                 l += beta * gathered;
                 record(&mut tree, node, |n| n.color = rgb(l, wl));
-                break;
+                if !goes_on {
+                    break;
+                }
             }
             if e == self.max_depth + 1 {
                 break;
@@ -201,6 +211,11 @@ impl<'a> PhotonMapper<'a> {
             ) else {
                 break;
             };
+            // After the gather only a specular sample goes on: its weight (with its lobe's
+            // probability in the pdf) estimates the specular lobes' share.
+            if flags.is_non_specular() && !bs.is_specular() {
+                break;
+            }
             beta *= bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
             if bs.is_transmission() {
                 counts.refraction += 1;
@@ -222,7 +237,8 @@ impl<'a> PhotonMapper<'a> {
     /// map's radiance at their first diffuse or glossy hit. An emitter a gather ray meets
     /// first is direct light, its share under MIS with the light sample; one met after
     /// specular bounces is a caustic (the caustic map's), unless every bounce from the eye
-    /// vertex on was specular: that light neither map holds.
+    /// vertex on was specular: that light neither map holds. Without `specular` a gather
+    /// ray sampled from a specular lobe counts nothing (the eye path goes on by that lobe).
     #[allow(clippy::too_many_arguments)]
     fn gather(
         &self,
@@ -234,6 +250,7 @@ impl<'a> PhotonMapper<'a> {
         counts: &mut RayCounts,
         e: u32,
         time: f64,
+        specular: bool,
         tree: &mut Option<&mut RayTree>,
         parent: Option<usize>,
     ) -> SampledSpectrum {
@@ -245,6 +262,9 @@ impl<'a> PhotonMapper<'a> {
             let Some(bs) = bsdf.sample_f(wo, uc, u, TransportMode::Radiance) else {
                 continue;
             };
+            if bs.is_specular() && !specular {
+                continue;
+            }
             let mut w = bs.f * (bs.wi.dot(x.shading_n).abs() / bs.pdf);
             let mut delta = bs.is_specular();
             // A gather ray and its specular continuation are one node of the ray tree.
@@ -288,7 +308,8 @@ impl<'a> PhotonMapper<'a> {
                 let Some(bsdf_z) = scene.bsdf(&it, wo_z, wl) else {
                     break;
                 };
-                if bsdf_z.flags().is_non_specular() {
+                let flags_z = bsdf_z.flags();
+                if flags_z.is_non_specular() {
                     let mut found = tree.is_some().then(Vec::new);
                     let (global, r2) =
                         self.estimate(&self.global, &it, wo_z, &bsdf_z, wl, ez, found.as_mut());
@@ -304,7 +325,11 @@ impl<'a> PhotonMapper<'a> {
                             })
                         });
                     }
-                    break;
+                    // The map holds what the diffuse and glossy lobes send; the specular
+                    // lobes' share (Phong glass, a mirror with a highlight) goes on.
+                    if !flags_z.is_specular() {
+                        break;
+                    }
                 }
                 if ez == self.max_depth + 1 {
                     break;
@@ -313,6 +338,11 @@ impl<'a> PhotonMapper<'a> {
                 let Some(bs) = bsdf_z.sample_f(wo_z, uc, u, TransportMode::Radiance) else {
                     break;
                 };
+                // After the estimate, only a specular sample goes on: its weight (with its
+                // lobe's probability in the pdf) estimates the specular lobes' share.
+                if flags_z.is_non_specular() && !bs.is_specular() {
+                    break;
+                }
                 w *= bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
                 delta &= bs.is_specular();
                 counts.reflection += 1;
@@ -432,7 +462,7 @@ fn photon_pass(
                 let time = camera.time(stream.next_1d());
                 tracer.trace(time, &mut wl, &mut stream, &mut counts, |a, wl| {
                     if caustic && !a.caustic {
-                        return false;
+                        return a.may_continue_caustic;
                     }
                     let power = rgb(a.beta * scale, wl);
                     if power.r.is_finite() && power.g.is_finite() && power.b.is_finite() {
@@ -444,7 +474,7 @@ fn photon_pass(
                             a.depth.min(u16::MAX as u32) as u16,
                         ));
                     }
-                    !caustic
+                    !caustic || a.may_continue_caustic
                 });
             }
             (photons, counts)

@@ -8,6 +8,13 @@
 //! deterministic selection per range, the two halves in parallel, so the same photons give
 //! the same tree on any number of threads.
 
+/// The least cosine between a photon's normal and the query's. On a sphere of radius R the
+/// surface within distance r of a point has area π r², the disc the estimate divides by,
+/// as long as every photon there counts: a tight bound (0.8, 37°) would leave out the
+/// rim of that cap once r exceeds 0.6 R and make curved surfaces dark; cos 84° keeps it
+/// to r ≈ 1.3 R and still excludes perpendicular walls.
+pub const FACING: f32 = 0.1;
+
 /// One photon: where it landed, where it came from, its flux as linear sRGB.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Photon {
@@ -15,8 +22,8 @@ pub struct Photon {
     /// Unit direction back toward where the photon came from.
     pub wi: [f32; 3],
     /// The unit geometric normal where it landed: photons are gathered only from surfaces
-    /// facing the same way as the query's (not from the other side of a wall, or the
-    /// perpendicular one in a corner).
+    /// facing the same way as the query's, within [`FACING`] (not from the other side of a
+    /// wall, or the perpendicular one in a corner).
     pub n: [f32; 3],
     /// Flux (W, or the scene's radiance unit × m² sr), linear sRGB, already divided by the
     /// number of photon paths of its pass.
@@ -181,7 +188,7 @@ impl PhotonMap {
         let d2: f32 = (0..3).map(|a| (q.p[a] - ph.p[a]).powi(2)).sum();
         if d2 < out.bound(k, q.max_distance2) && ph.depth <= q.max_depth {
             let facing: f32 = (0..3).map(|a| q.n[a] * ph.n[a]).sum();
-            if facing > 0.8 {
+            if facing > FACING {
                 out.push(k, d2, mid as u32);
             }
         }

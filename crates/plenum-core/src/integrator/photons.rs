@@ -33,6 +33,10 @@ pub(super) struct Arrival<'a> {
     pub depth: u32,
     /// Only specular bounces since the light (and at least one): a caustic photon, L S+ D.
     pub caustic: bool,
+    /// The path may still make caustics further on: no diffuse or glossy bounce since the
+    /// light, and the surface has a specular lobe to leave by (Phong glass, a mirror with a
+    /// highlight).
+    pub may_continue_caustic: bool,
 }
 
 /// Traces photon paths through one scene.
@@ -95,13 +99,15 @@ impl<'a> PhotonTracer<'a> {
             let Some(bsdf) = scene.bsdf(&it, wo, wl) else {
                 break;
             };
-            if bsdf.flags().is_non_specular() {
+            let flags = bsdf.flags();
+            if flags.is_non_specular() {
                 let arrival = Arrival {
                     it: &it,
                     wi: wo,
                     beta,
                     depth,
                     caustic: specular_only && depth > 1,
+                    may_continue_caustic: specular_only && flags.is_specular(),
                 };
                 if !arrive(&arrival, wl) {
                     break;

@@ -25,8 +25,10 @@
 //! sums do not depend on their order (see [`crate::film::SplatBuffer`]), so the image is the
 //! same for any thread count.
 //!
-//! Visible points are made at the first surface with a diffuse or glossy lobe: a BSDF that
-//! also has a specular lobe (a smooth coat) is seen there without it.
+//! Visible points are made at the first surface with a diffuse or glossy lobe. A surface that
+//! also has specular lobes (Phong glass, a smooth coat) gets a visible point for the first
+//! or a path on through a specular lobe, chosen at random by
+//! [`crate::bxdf::Bsdf::non_specular_fraction`] and divided by its probability.
 
 use super::direct::{bsdf_sample_ld, sample_ld};
 use super::light_tracing::rgb;
@@ -425,14 +427,44 @@ impl Eye<'_> {
             let Some(bsdf) = scene.bsdf(&it, wo, &mut wl) else {
                 break;
             };
-            if bsdf.flags().is_non_specular() {
+            let flags = bsdf.flags();
+            let mut visible_point = flags.is_non_specular();
+            // Where the path may go on, a surface with both kinds of lobe (Phong glass, a
+            // mirror with a highlight, a smooth coat) is two estimates: its diffuse and
+            // glossy lobes' at a visible point here, its specular lobes' further on. A pixel
+            // keeps one visible point, so one of the two is chosen, with probability q for
+            // the visible point, and divided by its probability.
+            let mut specular_only = false;
+            if visible_point && flags.is_specular() && e <= max_depth {
+                let q = bsdf.non_specular_fraction(wo).clamp(0.1, 0.9);
+                if stream.next_1d() < q {
+                    beta /= q;
+                } else {
+                    beta /= 1.0 - q;
+                    visible_point = false;
+                    specular_only = true;
+                }
+            }
+            if visible_point {
                 // Direct light by MIS of a light sample and one BSDF sample (none at the
-                // last vertex, where a path would not bounce).
+                // last vertex, where a path would not bounce); light that specular lobes
+                // find is the other estimate's.
                 let t = ray.time;
                 let n = if e <= max_depth { 1.0 } else { 0.0 };
                 l += beta * sample_ld(scene, &it, wo, &bsdf, &wl, &mut stream, counts, t, n);
                 if e <= max_depth {
-                    l += beta * bsdf_sample_ld(scene, &it, wo, &bsdf, &wl, &mut stream, counts, t);
+                    let ld = bsdf_sample_ld(
+                        scene,
+                        &it,
+                        wo,
+                        &bsdf,
+                        &wl,
+                        &mut stream,
+                        counts,
+                        t,
+                        !flags.is_specular(),
+                    );
+                    l += beta * ld;
                 }
                 if px.stats.radius == 0.0 {
                     px.stats.radius = match s.integrator.photon.radius {
@@ -459,6 +491,11 @@ impl Eye<'_> {
             let Some(bs) = bsdf.sample_f(wo, uc, u, TransportMode::Radiance) else {
                 break;
             };
+            // The specular lobes' estimate: a diffuse or glossy sample counts nothing, a
+            // specular one its weight (its lobe's probability is in its pdf).
+            if specular_only && !bs.is_specular() {
+                break;
+            }
             beta *= bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
             if bs.is_transmission() {
                 counts.refraction += 1;
