@@ -298,12 +298,18 @@ impl<'a> PhotonMapper<'a> {
                 };
                 let it = scene.interaction(&ray, prim, &hit);
                 let wo_z = -ray.direction.normalized();
+                // A light's surface may also carry a Phong k_e (its colour under Whitted): it
+                // is a light here, found under MIS at the first hit and by the caustic map
+                // after that; k_e alone, which no photon leaves, counts wherever it is seen.
                 if delta {
                     sum += w * emitted(scene, prim, &it, wo_z, wl);
+                } else if let Some(light) = scene.light_of(prim) {
+                    if ez == first {
+                        let le = direct::emitted_mis(scene, light, &it, wo_z, wl, pdf_bsdf, x.p, n);
+                        sum += w * le;
+                    }
                 } else if let Some(ke) = scene.phong_emission(&it, wl) {
                     sum += w * ke;
-                } else if let (Some(light), true) = (scene.light_of(prim), ez == first) {
-                    sum += w * direct::emitted_mis(scene, light, &it, wo_z, wl, pdf_bsdf, x.p, n);
                 }
                 let Some(bsdf_z) = scene.bsdf(&it, wo_z, wl) else {
                     break;
