@@ -569,7 +569,7 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
         .integrator
         .map(|a| a.0)
         .or(d.integrator)
-        .unwrap_or_else(|| loaded.scene.default_integrator());
+        .unwrap_or_else(|| IntegratorKind::default_for(&loaded.scene));
     let ignored = options_ignored_by(view, method);
     if !ignored.is_empty() {
         eprintln!(

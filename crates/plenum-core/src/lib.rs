@@ -20,6 +20,7 @@ pub mod raw_film;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod settings;
 pub mod texture;
 
 pub use color::Color;

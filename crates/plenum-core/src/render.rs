@@ -15,130 +15,19 @@
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::{Film, SplatBuffer};
-use crate::integrator::{
-    Integrator, IntegratorConfig, IntegratorKind, RayCounts, RayTree, StrategyImages,
-};
+use crate::integrator::{Integrator, IntegratorKind, RayCounts, RayTree, StrategyImages};
 use crate::raw_film::{PixelSums, RawFilm};
-use crate::sampling::{Filter, PixelSampler, Rng, SampleStream};
+use crate::sampling::{PixelSampler, Rng, SampleStream};
 use crate::scene::Scene;
+pub use crate::settings::{Adaptive, RenderControl, RenderOutput, RenderSettings, MAX_SUBDIVISION};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-#[derive(Clone, Debug, PartialEq)]
-pub struct RenderSettings {
-    pub width: u32,
-    pub height: u32,
-    pub sampler: PixelSampler,
-    /// How samples are weighted into pixels.
-    pub filter: Filter,
-    /// Spend samples where the image needs them; replaces the sampler's fixed count.
-    pub adaptive: Option<Adaptive>,
-    /// Which integrator, and its settings.
-    pub integrator: IntegratorConfig,
-    pub seed: u64,
-    /// The SPD test procedure (Haines 1987): one ray through every pixel corner, (W+1)×(H+1)
-    /// rays in all, each pixel the average of its four corners. Replaces the sampler.
-    pub corners: bool,
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        RenderSettings {
-            width: 640,
-            height: 480,
-            sampler: PixelSampler::Grid { n: 1 },
-            filter: Filter::default(),
-            adaptive: None,
-            integrator: IntegratorConfig::default(),
-            seed: 0,
-            corners: false,
-        }
-    }
-}
-
-impl RenderSettings {
-    /// Whether the integrator can work with these settings; the reason where it cannot.
-    pub fn check(&self) -> Result<(), String> {
-        let kind = self.integrator.kind;
-        if matches!(kind, IntegratorKind::Photon | IntegratorKind::Sppm) {
-            self.integrator.photon.check()?;
-        }
-        if kind == IntegratorKind::Sppm {
-            if self.adaptive.is_some() || self.corners {
-                return Err("integrator `sppm` renders a fixed number of iterations (--spp): adaptive sampling and the SPD corners are not available with it".to_string());
-            }
-            if self.filter != Filter::default() {
-                return Err("integrator `sppm` gathers each pixel over its own square (a box filter of one pixel); other filters are not available with it".to_string());
-            }
-        }
-        if kind.splats() {
-            let name = kind.name();
-            if self.adaptive.is_some() {
-                return Err(format!("integrator `{name}` adds light to pixels other than the one sampled, so it needs a fixed number of samples per pixel: adaptive sampling is not available with it"));
-            }
-            if self.corners {
-                return Err(format!(
-                    "integrator `{name}` cannot trace the SPD pixel corners (--nff-corners)"
-                ));
-            }
-            if self.integrator.strategies && self.filter != Filter::default() {
-                return Err("--write-strategies needs the box filter of one pixel: a strategy image takes each contribution where it lands".to_string());
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Adaptive sampling.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Adaptive {
-    /// Whitted (1980): trace the pixel's four corners; where they differ by more than
-    /// `contrast` (Mitchell's (max − min)/(max + min) of luminance), split the square in four
-    /// and trace the new corners, down to `depth` levels (at most [`MAX_SUBDIVISION`]). The
-    /// pixel is the area-weighted mean of its smallest squares' corner means (a box filter).
-    Subdivide { contrast: f64, depth: u32 },
-    /// Sample every pixel with `min_spp` Sobol points; then, in batches of `min_spp`, every
-    /// pixel whose error estimate or a neighbour's is still too high, until the standard error
-    /// of its luminance falls below `threshold` × max(mean, 0.05) — relative error in lit
-    /// pixels, absolute in dark ones — or `max_spp` samples are spent. A pixel refined
-    /// because of its neighbour takes at least one batch more.
-    Variance {
-        threshold: f64,
-        min_spp: u32,
-        max_spp: u32,
-    },
-}
-
-/// The deepest subdivision `Adaptive::Subdivide` may ask for: 16 × 16 squares per pixel.
-pub const MAX_SUBDIVISION: u32 = 4;
-
 /// Side of the square tiles the image is cut into.
 pub const TILE_SIZE: u32 = 16;
-
-#[derive(Clone, Debug)]
-pub struct RenderOutput {
-    pub film: Film,
-    pub counts: RayCounts,
-    /// False when the render was cancelled: tiles not yet rendered are black.
-    pub complete: bool,
-    /// Bidirectional path tracing with `strategies` set: for each strategy (s, t), its
-    /// image weighted by MIS and unweighted.
-    pub strategies: Vec<(usize, usize, Film, Film)>,
-}
-
-/// What the caller of [`render_film`] may do while it runs.
-pub struct RenderControl<'a> {
-    /// Set: the render stops between tiles (the film keeps what is done).
-    pub cancel: &'a AtomicBool,
-    /// Called after each tile with (tiles done, tiles in all).
-    pub progress: &'a (dyn Fn(usize, usize) + Sync),
-    /// Every so often, between tiles with none in flight, the film so far: what a
-    /// checkpoint saves.
-    pub checkpoint: Option<(Duration, &'a mut dyn FnMut(&RawFilm))>,
-}
 
 /// An empty film for `settings`, to hold sample indices `samples` of every pixel (of all
 /// `settings.sampler`'s samples; ignored by adaptive sampling and the SPD corners). SPPM's

@@ -15,8 +15,7 @@ use crate::texture::TextureCoords;
 use plenum_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 use std::sync::Arc;
 
-/// Index of a material in [`Scene::materials`].
-pub type MaterialId = u32;
+pub use crate::material::MaterialId;
 
 /// A shape placed in the world with a material.
 #[derive(Clone, Debug)]
@@ -462,21 +461,16 @@ impl Scene {
                 .all(|m| m.phong().is_none_or(|p| p.emissive.is_black()))
     }
 
-    /// `path` for a scene whose objects are all of physically based materials (emitters that
-    /// only show their light aside), `whitted` otherwise.
-    pub fn default_integrator(&self) -> crate::integrator::IntegratorKind {
-        use crate::integrator::IntegratorKind;
-        let physical = self.primitives.iter().all(|p| {
-            p.vertex_materials.is_none() && {
-                let m = &self.materials[p.material as usize];
-                m.is_physical() || m.is_emitter_only()
-            }
-        });
-        if physical && !self.primitives.is_empty() {
-            IntegratorKind::Path
-        } else {
-            IntegratorKind::Whitted
-        }
+    /// The scene has objects, and all of them are of physically based materials (emitters
+    /// that only show their light aside).
+    pub fn is_physically_based(&self) -> bool {
+        !self.primitives.is_empty()
+            && self.primitives.iter().all(|p| {
+                p.vertex_materials.is_none() && {
+                    let m = &self.materials[p.material as usize];
+                    m.is_physical() || m.is_emitter_only()
+                }
+            })
     }
 
     /// What in the scene varies with wavelength beyond what RGB can carry (a dispersive

@@ -23,7 +23,7 @@ fn pixels(l: &LoadedScene) -> Vec<[f32; 3]> {
             kind: l
                 .defaults
                 .integrator
-                .unwrap_or_else(|| l.scene.default_integrator()),
+                .unwrap_or_else(|| IntegratorKind::default_for(&l.scene)),
             max_depth: l.defaults.max_depth,
             min_weight: l.defaults.min_weight,
             rr_depth: l.defaults.rr_depth,
@@ -61,7 +61,7 @@ fn round_trip(original: LoadedScene, what: &str) {
         .flat_map(|(p, q)| (0..3).map(move |i| (p[i] - q[i]).abs()))
         .collect();
     let worst = differences.iter().copied().fold(0.0f32, f32::max);
-    if original.scene.default_integrator() == IntegratorKind::Whitted {
+    if IntegratorKind::default_for(&original.scene) == IntegratorKind::Whitted {
         assert!(worst < 1e-4, "{what}: largest pixel difference {worst}");
     } else {
         // A placement written as a matrix has its inverse computed anew, a last-bit

@@ -264,7 +264,7 @@ emission = [17, 12, 4]
 two_sided = false
 "#,
     );
-    assert_eq!(l.scene.default_integrator(), IntegratorKind::Path);
+    assert_eq!(IntegratorKind::default_for(&l.scene), IntegratorKind::Path);
     for (color, tolerance) in [(ColorMode::Rgb, 1e-6), (ColorMode::Spectral, 0.01)] {
         let m = mean(&draw(&l, &path_settings(&l, 64, color, 2)));
         for (got, want) in m.iter().zip([17.0, 12.0, 4.0]) {
@@ -275,7 +275,7 @@ two_sided = false
         }
     }
     assert_eq!(
-        plenum_scene::builtin_scene().scene.default_integrator(),
+        IntegratorKind::default_for(&plenum_scene::builtin_scene().scene),
         IntegratorKind::Whitted
     );
 }

@@ -12,18 +12,6 @@ use crate::color::xyz_to_linear_srgb;
 use crate::sampled::{SampledSpectrum, SampledWavelengths, N_SAMPLES};
 use crate::uplift::{d65_normalized, RgbSigmoid, RgbToSpectrumTable};
 
-/// Linear interpolation in a table sampled every `step` nm from `start` nm; 0 outside.
-pub(crate) fn uniform_lerp(table: &[f64], start: f64, step: f64, lambda: f64) -> f64 {
-    let x = (lambda - start) / step;
-    let last = (table.len() - 1) as f64;
-    if !(0.0..=last).contains(&x) {
-        return 0.0;
-    }
-    let i = (x as usize).min(table.len() - 2);
-    let t = x - i as f64;
-    table[i] + t * (table[i + 1] - table[i])
-}
-
 /// Linear sRGB of `f` as a reflectance under D65: ∫ f D65 x̄ȳz̄ dλ / ∫ D65 ȳ dλ at 1 nm over
 /// 360–830 nm, then [`crate::color::XYZ_TO_SRGB`]. A constant 1 gives (1, 1, 1) (to 1e-3,
 /// the sRGB matrix's rounding of the white point).

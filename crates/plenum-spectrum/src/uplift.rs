@@ -43,7 +43,19 @@ pub fn d65_normalized(lambda: f64) -> f64 {
 }
 
 fn d65_raw(lambda: f64) -> f64 {
-    crate::spectrum::uniform_lerp(&ILLUM_D65, ILLUM_D65_START, 5.0, lambda)
+    uniform_lerp(&ILLUM_D65, ILLUM_D65_START, 5.0, lambda)
+}
+
+/// Linear interpolation in a table sampled every `step` nm from `start` nm; 0 outside.
+fn uniform_lerp(table: &[f64], start: f64, step: f64, lambda: f64) -> f64 {
+    let x = (lambda - start) / step;
+    let last = (table.len() - 1) as f64;
+    if !(0.0..=last).contains(&x) {
+        return 0.0;
+    }
+    let i = (x as usize).min(table.len() - 2);
+    let t = x - i as f64;
+    table[i] + t * (table[i + 1] - table[i])
 }
 
 /// A reflectance-like spectrum s(c0 λ² + c1 λ + c2), λ in nm, values in (0, 1).

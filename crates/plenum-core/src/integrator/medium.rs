@@ -4,7 +4,7 @@
 //! The stack records the solids' materials, not their indices, so that an index can be
 //! looked up at the wavelength a path carries (a dispersive medium's η varies with λ).
 
-use crate::scene::MaterialId;
+use crate::material::MaterialId;
 
 const CAPACITY: usize = 8;
 

@@ -49,6 +49,8 @@ impl Photon {
 
 /// The most photons one query may gather.
 pub const MAX_NEAREST: usize = 512;
+// The setting's limit leaves room for the one more photon a search keeps.
+const _: () = assert!(crate::settings::MAX_NEAREST as usize + 1 <= MAX_NEAREST);
 
 /// What a query looks for.
 #[derive(Clone, Copy, Debug)]

@@ -15,7 +15,10 @@
 //! k_t; a direction drawn below the surface carries nothing). Their random numbers come from
 //! the pixel sample's stream, so the sampler stratifies them across the pixel's samples.
 
-use super::{MediumStack, RayKind, RayNode, RayTree, ShadowInfo, Stop};
+use super::{
+    IntegratorConfig, IntegratorKind, MediumStack, RayCounts, RayKind, RayNode, RayTree,
+    ShadowInfo, Stop,
+};
 use crate::accel::Coherence;
 use crate::color::Color;
 use crate::light::Incident;
@@ -23,10 +26,6 @@ use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::optics::{fresnel_dielectric, reflect, refract};
 use crate::sampling::{phong_lobe, Frame, SampleStream};
 use crate::scene::{Interaction, Scene};
-
-/// The deepest recursion allowed: each bounce is a stack frame, and past a few hundred
-/// bounces the render threads' stacks would overflow.
-pub const MAX_DEPTH: u32 = 100;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WhittedConfig {
@@ -41,51 +40,20 @@ pub struct WhittedConfig {
 
 impl Default for WhittedConfig {
     fn default() -> Self {
+        IntegratorConfig::default().whitted()
+    }
+}
+
+impl IntegratorConfig {
+    /// Whitted's settings; local illumination and Appel's method are Whitted's without
+    /// recursion, local illumination also without shadow rays.
+    pub fn whitted(&self) -> WhittedConfig {
+        let recursive = self.kind == IntegratorKind::Whitted;
         WhittedConfig {
-            max_depth: 5,
-            min_weight: 1.0 / 256.0,
-            shadows: true,
+            max_depth: if recursive { self.max_depth } else { 0 },
+            min_weight: self.min_weight,
+            shadows: self.kind != IntegratorKind::Local,
         }
-    }
-}
-
-/// Rays traced, by kind.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct RayCounts {
-    pub camera: u64,
-    pub shadow: u64,
-    pub reflection: u64,
-    pub refraction: u64,
-    /// Rays of light paths: leaving a light and scattered along the path.
-    pub light: u64,
-    /// Connections between a path's vertex and the camera or another path's vertex.
-    pub connection: u64,
-    /// Photon rays (photon mapping's passes).
-    pub photon: u64,
-    /// Samples that came out NaN or infinite and were left out of the film.
-    pub invalid: u64,
-}
-
-impl RayCounts {
-    pub fn total(&self) -> u64 {
-        self.camera
-            + self.shadow
-            + self.reflection
-            + self.refraction
-            + self.light
-            + self.connection
-            + self.photon
-    }
-
-    pub fn add(&mut self, o: &RayCounts) {
-        self.camera += o.camera;
-        self.shadow += o.shadow;
-        self.reflection += o.reflection;
-        self.refraction += o.refraction;
-        self.light += o.light;
-        self.connection += o.connection;
-        self.photon += o.photon;
-        self.invalid += o.invalid;
     }
 }
 

@@ -22,9 +22,11 @@ pub use physical::{
 
 use crate::bxdf::{Bxdf, PhongBxdf};
 use crate::color::Color;
-use crate::scene::MaterialId;
 use crate::texture::TextureCoords;
 use plenum_spectrum::{SampledSpectrum, SampledWavelengths};
+
+/// Index of a material in a scene's table (`Scene::materials`).
+pub type MaterialId = u32;
 
 #[derive(Clone, Debug)]
 pub enum Material {
