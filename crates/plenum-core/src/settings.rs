@@ -110,7 +110,7 @@ pub struct PhotonConfig {
     /// Photon mapping: the photons a density estimate gathers (k), 1 to [`MAX_NEAREST`].
     pub nearest: u32,
     /// Photon mapping: the largest gather radius; SPPM: the initial radius (scene units).
-    /// 0: automatic (a tenth of the scene's bounding radius; for SPPM, two pixels' footprint
+    /// 0: automatic (a tenth of the scene's bounding radius; for SPPM, one pixel's footprint
     /// at each pixel's first visible point).
     pub radius: f64,
     /// Photon mapping: final-gather rays per camera sample.

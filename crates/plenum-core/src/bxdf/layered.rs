@@ -133,7 +133,7 @@ impl CoatedDiffuseBxdf {
     /// Under a smooth coat: the base's reflectance through the coat, (1 − F)·R, against
     /// the coat's own reflection F, at `wo` (an estimate that ignores interreflection and
     /// the medium: it only chooses between the two kinds of lobe).
-    pub fn non_specular_fraction(&self, wo: Vec3) -> f64 {
+    pub fn diffuse_fraction(&self, wo: Vec3) -> f64 {
         let f = fr_dielectric(wo.z.abs(), self.top.eta);
         let base = (1.0 - f) * self.bottom.r.average();
         if base + f > 0.0 {

@@ -238,23 +238,61 @@ impl Bxdf {
         }
     }
 
-    /// Roughly the share of the light leaving toward `wo` that comes by the diffuse and
-    /// glossy lobes rather than the specular ones, in [0, 1]: 1 without a specular lobe, 0
-    /// with only specular ones. A method that must choose between the two kinds at one
-    /// vertex (SPPM keeps one visible point per pixel) chooses by it; any value strictly
-    /// between 0 and 1 keeps its estimate unbiased, a good one keeps the variance low.
-    pub fn non_specular_fraction(&self, wo: Vec3) -> f64 {
-        let flags = self.flags();
-        if !flags.is_specular() {
-            return 1.0;
+    /// The BSDF as two: its diffuse lobes, and the rest (glossy and specular), each a BSDF
+    /// of its own, whose values and delta lobes add up to this one's; `None` for a part it
+    /// lacks. A Phong material splits into k_d and the other lobes; a coat over a diffuse
+    /// base keeps the base (and a rough coat's reflection) and gives its smooth coat's
+    /// mirror reflection, F(θ) by Fresnel, to the rest. SPPM leaves visible points on the
+    /// diffuse part and traces the rest, as pbrt-v4 does for glossy surfaces: a sharp
+    /// glossy lobe times a photon's flux is an estimate of enormous variance.
+    pub fn split_diffuse(&self) -> (Option<Bxdf>, Option<Bxdf>) {
+        match *self {
+            Bxdf::Phong(b) => {
+                let zero = SampledSpectrum::ZERO;
+                let diffuse = (!b.kd.is_black()).then_some(Bxdf::Phong(PhongBxdf {
+                    ks: zero,
+                    kr: zero,
+                    kt: zero,
+                    ..b
+                }));
+                let others = !(b.ks.is_black() && b.kr.is_black() && b.kt.is_black());
+                let rest = others.then_some(Bxdf::Phong(PhongBxdf { kd: zero, ..b }));
+                (diffuse, rest)
+            }
+            Bxdf::CoatedDiffuse(b) if b.top.flags().is_specular() => {
+                let mirror = PhongBxdf {
+                    kd: SampledSpectrum::ZERO,
+                    ks: SampledSpectrum::ZERO,
+                    exponent: 1.0,
+                    kr: SampledSpectrum::ONE,
+                    kt: SampledSpectrum::ZERO,
+                    eta: b.top.eta,
+                    thin: true,
+                    fresnel: true,
+                };
+                (Some(*self), Some(Bxdf::Phong(mirror)))
+            }
+            Bxdf::Diffuse(_) | Bxdf::DiffuseTransmission(_) | Bxdf::CoatedDiffuse(_) => {
+                (Some(*self), None)
+            }
+            Bxdf::Conductor(_) | Bxdf::Dielectric(_) | Bxdf::ThinDielectric(_) => {
+                (None, Some(*self))
+            }
         }
-        if !flags.is_non_specular() {
-            return 0.0;
-        }
+    }
+
+    /// Roughly the share of the light leaving toward `wo` that [`split_diffuse`]'s diffuse
+    /// part carries, in [0, 1]. A method that must choose between the parts at one vertex
+    /// (SPPM keeps one visible point per pixel) chooses by it; any value strictly between 0
+    /// and 1 keeps its estimate unbiased, a good one keeps the variance low.
+    ///
+    /// [`split_diffuse`]: Bxdf::split_diffuse
+    pub fn diffuse_fraction(&self, wo: Vec3) -> f64 {
         match self {
-            Bxdf::Phong(b) => b.non_specular_fraction(wo),
-            Bxdf::CoatedDiffuse(b) => b.non_specular_fraction(wo),
-            _ => 0.5,
+            Bxdf::Phong(b) => b.diffuse_fraction(wo),
+            Bxdf::CoatedDiffuse(b) if b.top.flags().is_specular() => b.diffuse_fraction(wo),
+            Bxdf::Diffuse(_) | Bxdf::DiffuseTransmission(_) | Bxdf::CoatedDiffuse(_) => 1.0,
+            Bxdf::Conductor(_) | Bxdf::Dielectric(_) | Bxdf::ThinDielectric(_) => 0.0,
         }
     }
 
@@ -317,9 +355,17 @@ impl Bsdf {
         self.bxdf.flags()
     }
 
-    /// [`Bxdf::non_specular_fraction`] toward the world direction `wo`.
-    pub fn non_specular_fraction(&self, wo_world: Vec3) -> f64 {
-        self.bxdf.non_specular_fraction(self.to_local(wo_world))
+    /// [`Bxdf::split_diffuse`], each part in this BSDF's frame.
+    pub fn split_diffuse(&self) -> (Option<Bsdf>, Option<Bsdf>) {
+        let (diffuse, rest) = self.bxdf.split_diffuse();
+        let frame = self.frame;
+        let place = |bxdf| Bsdf { frame, bxdf };
+        (diffuse.map(place), rest.map(place))
+    }
+
+    /// [`Bxdf::diffuse_fraction`] toward the world direction `wo`.
+    pub fn diffuse_fraction(&self, wo_world: Vec3) -> f64 {
+        self.bxdf.diffuse_fraction(self.to_local(wo_world))
     }
 
     pub fn f(&self, wo_world: Vec3, wi_world: Vec3, mode: TransportMode) -> SampledSpectrum {

@@ -106,12 +106,12 @@ impl PhongBxdf {
         }
     }
 
-    /// The diffuse and glossy lobes' share of the lobe selection weights at `wo`.
-    pub fn non_specular_fraction(&self, wo: Vec3) -> f64 {
+    /// The diffuse lobe's share of the lobe selection weights at `wo`.
+    pub fn diffuse_fraction(&self, wo: Vec3) -> f64 {
         let w = self.lobes(wo).weights;
         let total: f64 = w.iter().sum();
         if total > 0.0 {
-            (w[0] + w[1]) / total
+            w[0] / total
         } else {
             1.0
         }

@@ -128,12 +128,23 @@ pub(super) fn bsdf_pdf(bsdf: &Bsdf, wo: Vec3, bs: &crate::bxdf::BsdfSample) -> f
     }
 }
 
+/// Which of a BSDF sample's lobes [`bsdf_sample_ld`] counts; a sample from another counts
+/// nothing (its light is found another way).
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(super) enum Lobes {
+    All,
+    /// A path also goes on through the specular lobes and finds their light there.
+    NonSpecular,
+    /// The light sample took the others in full (a last vertex's, with no BSDF sample
+    /// to weigh it against).
+    Specular,
+}
+
 /// One BSDF-sampled ray's part of direct light at `it` toward `wo`, for a path that does not
 /// go on from `it` (SPPM's visible point, the path tracer's last vertex): the emitter or
 /// infinite light it finds, weighed against one light sample, and in full what light
 /// sampling cannot find: the background, a Phong surface's k_e, and whatever a specular
-/// lobe's direction meets (unless `specular` is false: a path that also goes on through
-/// the specular lobes finds that light there, and a specular sample here counts nothing).
+/// lobe's direction meets; from the lobes `lobes` names.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn bsdf_sample_ld(
     scene: &Scene,
@@ -144,13 +155,18 @@ pub(super) fn bsdf_sample_ld(
     stream: &mut SampleStream,
     counts: &mut RayCounts,
     time: f64,
-    specular: bool,
+    lobes: Lobes,
 ) -> SampledSpectrum {
     let (uc, u) = (stream.next_1d(), stream.next_2d());
     let Some(bs) = bsdf.sample_f(wo, uc, u, TransportMode::Radiance) else {
         return SampledSpectrum::ZERO;
     };
-    if bs.is_specular() && !specular {
+    let counted = match lobes {
+        Lobes::All => true,
+        Lobes::NonSpecular => !bs.is_specular(),
+        Lobes::Specular => bs.is_specular(),
+    };
+    if !counted {
         return SampledSpectrum::ZERO;
     }
     let beta = bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);

@@ -11,6 +11,7 @@
 //! into linear sRGB once at the end. A sample that comes out NaN or infinite is counted in
 //! [`RayCounts::invalid`] and left out of the film.
 
+use super::direct::Lobes;
 use super::{
     direct, record, record_hit, IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Stop,
 };
@@ -151,7 +152,15 @@ impl<'a> PathTracer<'a> {
                 // pbrt-v4's and Mitsuba's path tracers count depth).
                 l += beta
                     * direct::bsdf_sample_ld(
-                        scene, &it, wo, &bsdf, wl, stream, counts, ray.time, true,
+                        scene,
+                        &it,
+                        wo,
+                        &bsdf,
+                        wl,
+                        stream,
+                        counts,
+                        ray.time,
+                        Lobes::All,
                     );
                 record(&mut tree, node, |n| {
                     n.color = added(l, wl);

@@ -168,6 +168,22 @@ impl<'a> PhotonMapper<'a> {
             // gathered for its diffuse and glossy lobes, and the eye path goes on through its
             // specular ones, so that what they show is seen as sharply as through pure glass.
             let goes_on = flags.is_specular() && e <= self.max_depth;
+            if flags.is_specular() && e == self.max_depth + 1 {
+                // The light a last vertex's specular lobes show (a lamp or the sky in a
+                // mirror), which the path tracer's last vertex also takes.
+                let ld = direct::bsdf_sample_ld(
+                    scene,
+                    &it,
+                    wo,
+                    &bsdf,
+                    wl,
+                    stream,
+                    counts,
+                    ray.time,
+                    direct::Lobes::Specular,
+                );
+                l += beta * ld;
+            }
             if flags.is_non_specular() {
                 let time = ray.time;
                 // The gather rays are the BSDF samples MIS weighs the light sample against.

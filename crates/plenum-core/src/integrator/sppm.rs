@@ -25,14 +25,17 @@
 //! sums do not depend on their order (see [`crate::film::SplatBuffer`]), so the image is the
 //! same for any thread count.
 //!
-//! Visible points are made at the first surface with a diffuse or glossy lobe. A surface that
-//! also has specular lobes (Phong glass, a smooth coat) gets a visible point for the first
-//! or a path on through a specular lobe, chosen at random by
-//! [`crate::bxdf::Bsdf::non_specular_fraction`] and divided by its probability.
+//! Visible points are made at the first surface with a diffuse lobe, on that lobe alone
+//! ([`crate::bxdf::Bsdf::split_diffuse`]): glossy and specular lobes are traced on, with next-
+//! event estimation under MIS as in the path tracer (pbrt-v4 does so for glossy surfaces: a
+//! sharp glossy lobe times a photon's flux is an estimate of enormous variance); at the
+//! last vertex a glossy surface gets one too. A surface with both parts (a Phong mirror
+//! with some k_d, a smooth coat) gets a visible point or a traced path, chosen at random by
+//! [`crate::bxdf::Bsdf::diffuse_fraction`] and divided by its probability.
 
-use super::direct::{bsdf_sample_ld, sample_ld};
+use super::direct::{bsdf_pdf, bsdf_sample_ld, emitted_mis, infinite_mis, sample_ld, Lobes};
 use super::light_tracing::rgb;
-use super::photons::{emitted, escaped, Arrival, PhotonTracer};
+use super::photons::{Arrival, PhotonTracer};
 use super::{
     record, record_hit, FoundPhoton, PhotonGather, RayCounts, RayKind, RayNode, RayTree, Stop,
 };
@@ -54,7 +57,10 @@ const CHUNK: u64 = 4096;
 /// The fixed point of the photon sums: 28 bits of fraction.
 const UNIT: f64 = 1.0 / 268_435_456.0;
 /// An automatic initial radius spans this many pixels' footprints at the visible point.
-const FOOTPRINT_PIXELS: f64 = 2.0;
+/// Density estimation darkens where a gather disc reaches past a surface's edge (a box's
+/// corners); two footprints left those blocks 9–13σ dark against Mitsuba at 16 iterations,
+/// one leaves them within the noise.
+const FOOTPRINT_PIXELS: f64 = 1.0;
 
 /// Where a pixel's camera path met its first diffuse or glossy surface, this iteration.
 #[derive(Clone, Copy)]
@@ -400,6 +406,11 @@ impl Eye<'_> {
         let mut distance = 0.0;
         let max_depth = s.integrator.max_depth;
         let (mut kind, mut parent) = (RayKind::Camera, None);
+        // For MIS on light the path finds after a traced (glossy) bounce, as in the path
+        // tracer: the pdf of the direction it left by, and where it left from. The camera
+        // ray and specular bounces take what they find in full.
+        let mut pdf_bsdf = f64::INFINITY;
+        let mut previous = ray.origin;
         for e in 1..=max_depth + 1 {
             let node = tree.as_deref_mut().map(|t| {
                 let weight = rgb(beta, &wl);
@@ -414,7 +425,8 @@ impl Eye<'_> {
             });
             parent = node;
             let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
-                l += beta * escaped(scene, ray.direction.normalized(), &wl, true);
+                let d = ray.direction.normalized();
+                l += beta * infinite_mis(scene, d, &wl, pdf_bsdf, 1.0);
                 record(&mut tree, node, |n| n.stops.push(Stop::Miss));
                 break;
             };
@@ -423,47 +435,55 @@ impl Eye<'_> {
             record_hit(&mut tree, node, scene, prim, t);
             let it = scene.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
-            l += beta * emitted(scene, prim, &it, wo, &wl);
+            if let Some(light) = scene.light_of(prim) {
+                l += beta * emitted_mis(scene, light, &it, wo, &wl, pdf_bsdf, previous, 1.0);
+            } else if let Some(ke) = scene.phong_emission(&it, &wl) {
+                l += beta * ke;
+            }
             let Some(bsdf) = scene.bsdf(&it, wo, &mut wl) else {
                 break;
             };
-            let flags = bsdf.flags();
-            let mut visible_point = flags.is_non_specular();
-            // Where the path may go on, a surface with both kinds of lobe (Phong glass, a
-            // mirror with a highlight, a smooth coat) is two estimates: its diffuse and
-            // glossy lobes' at a visible point here, its specular lobes' further on. A pixel
-            // keeps one visible point, so one of the two is chosen, with probability q for
-            // the visible point, and divided by its probability.
-            let mut specular_only = false;
-            if visible_point && flags.is_specular() && e <= max_depth {
-                let q = bsdf.non_specular_fraction(wo).clamp(0.1, 0.9);
-                if stream.next_1d() < q {
-                    beta /= q;
-                } else {
-                    beta /= 1.0 - q;
-                    visible_point = false;
-                    specular_only = true;
+            // The diffuse part gets a visible point, the rest (glossy and specular lobes) is
+            // traced on; at the last vertex a diffuse or glossy surface gets one whole.
+            let last = e == max_depth + 1;
+            let (gathered, traced) = if last {
+                (bsdf.flags().is_non_specular().then_some(bsdf), None)
+            } else {
+                bsdf.split_diffuse()
+            };
+            // A pixel keeps one visible point, so a surface with both parts is one of the
+            // two estimates, chosen with probability q for the visible point and divided by
+            // its probability.
+            let (gathered, traced) = match (gathered, traced) {
+                (Some(g), Some(r)) => {
+                    let q = bsdf.diffuse_fraction(wo).clamp(0.1, 0.9);
+                    if stream.next_1d() < q {
+                        beta /= q;
+                        (Some(g), None)
+                    } else {
+                        beta /= 1.0 - q;
+                        (None, Some(r))
+                    }
                 }
+                parts => parts,
+            };
+            let t = ray.time;
+            if last {
+                // What the path tracer's last vertex also takes: the light its specular
+                // lobes show (a lamp or the sky in a mirror), which no light sample finds.
+                let lobes = Lobes::Specular;
+                l += beta
+                    * bsdf_sample_ld(scene, &it, wo, &bsdf, &wl, &mut stream, counts, t, lobes);
             }
-            if visible_point {
+            if let Some(g) = gathered {
                 // Direct light by MIS of a light sample and one BSDF sample (none at the
-                // last vertex, where a path would not bounce); light that specular lobes
-                // find is the other estimate's.
-                let t = ray.time;
-                let n = if e <= max_depth { 1.0 } else { 0.0 };
-                l += beta * sample_ld(scene, &it, wo, &bsdf, &wl, &mut stream, counts, t, n);
-                if e <= max_depth {
-                    let ld = bsdf_sample_ld(
-                        scene,
-                        &it,
-                        wo,
-                        &bsdf,
-                        &wl,
-                        &mut stream,
-                        counts,
-                        t,
-                        !flags.is_specular(),
-                    );
+                // last vertex, where a path would not bounce); the traced part's light is
+                // the other estimate's.
+                let n = if last { 0.0 } else { 1.0 };
+                l += beta * sample_ld(scene, &it, wo, &g, &wl, &mut stream, counts, t, n);
+                if !last {
+                    let lobes = Lobes::NonSpecular;
+                    let ld = bsdf_sample_ld(scene, &it, wo, &g, &wl, &mut stream, counts, t, lobes);
                     l += beta * ld;
                 }
                 if px.stats.radius == 0.0 {
@@ -477,26 +497,30 @@ impl Eye<'_> {
                     n: it.n,
                     shading_n: it.shading_n,
                     wo,
-                    bsdf,
+                    bsdf: g,
                     beta,
                     depth: e,
                     wl,
                 });
                 break;
             }
-            if e == max_depth + 1 {
-                break;
-            }
-            let (uc, u) = (stream.next_1d(), stream.next_2d());
-            let Some(bs) = bsdf.sample_f(wo, uc, u, TransportMode::Radiance) else {
+            let Some(r) = traced else {
                 break;
             };
-            // The specular lobes' estimate: a diffuse or glossy sample counts nothing, a
-            // specular one its weight (its lobe's probability is in its pdf).
-            if specular_only && !bs.is_specular() {
-                break;
+            // The traced part as the path tracer takes it: a light sample weighed by MIS
+            // against the BSDF sample that goes on.
+            if r.flags().is_non_specular() {
+                l += beta * sample_ld(scene, &it, wo, &r, &wl, &mut stream, counts, t, 1.0);
             }
+            let (uc, u) = (stream.next_1d(), stream.next_2d());
+            let Some(bs) = r.sample_f(wo, uc, u, TransportMode::Radiance) else {
+                break;
+            };
             beta *= bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
+            pdf_bsdf = match bs.is_specular() {
+                true => f64::INFINITY,
+                false => bsdf_pdf(&r, wo, &bs),
+            };
             if bs.is_transmission() {
                 counts.refraction += 1;
                 kind = RayKind::Refracted;
@@ -507,6 +531,7 @@ impl Eye<'_> {
             if beta.is_black() {
                 break;
             }
+            previous = it.p;
             ray =
                 Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(ray.time);
         }
