@@ -312,4 +312,3 @@ reference_tests! {
     light_delta: "delta", Light, 128;
     light_rough: "rough", Light, 64;
 }
-

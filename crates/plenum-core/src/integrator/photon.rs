@@ -1,7 +1,10 @@
 //! Photon mapping as Jensen (1996) does it: a photon pass before rendering fills a global
 //! map (every photon landing on a diffuse or glossy surface) and a caustic map (photons that
-//! came L S+ D: only specular bounces since the light); the eye pass follows specular
-//! bounces to the first diffuse or glossy surface and adds there
+//! came L S+ D: only specular bounces since the light); the eye pass is traced as the path
+//! tracer traces it through glossy and specular lobes to the first surface with a diffuse
+//! lobe, and adds there, for that diffuse part ([`crate::bxdf::Bsdf::split_diffuse`]; a
+//! surface with both parts is gathered for the one and traced on for the other, and a last
+//! vertex is gathered whole)
 //! - direct light, by next-event estimation weighed by MIS against the gather rays that
 //!   find an emitter ([`super::direct`]);
 //! - caustics, the caustic map's density estimate at that point;
@@ -138,6 +141,10 @@ impl<'a> PhotonMapper<'a> {
         let mut ray = *camera_ray;
         let mut kind = RayKind::Camera;
         let mut parent = None;
+        // For MIS on light the path finds after a traced glossy bounce, as in the path
+        // tracer; the camera ray and specular bounces take what they find in full.
+        let mut pdf_bsdf = f64::INFINITY;
+        let mut previous = ray.origin;
         // e: the eye vertex, 1 for the camera ray's hit.
         for e in 1..=self.max_depth + 1 {
             let node = tree.as_deref_mut().map(|t| {
@@ -152,50 +159,48 @@ impl<'a> PhotonMapper<'a> {
             });
             parent = node;
             let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
-                l += beta * escaped(self.scene, ray.direction.normalized(), wl, true);
+                let d = ray.direction.normalized();
+                l += beta * direct::infinite_mis(scene, d, wl, pdf_bsdf, 1.0);
                 break;
             };
             let it = scene.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
             record_hit(&mut tree, node, scene, prim, hit.t * ray.direction.length());
-            // Only the camera ray and specular bounces get here: emitters count in full.
-            l += beta * emitted(self.scene, prim, &it, wo, wl);
+            if let Some(light) = scene.light_of(prim) {
+                l += beta * direct::emitted_mis(scene, light, &it, wo, wl, pdf_bsdf, previous, 1.0);
+            } else if let Some(ke) = scene.phong_emission(&it, wl) {
+                l += beta * ke;
+            }
             let Some(bsdf) = scene.bsdf(&it, wo, wl) else {
                 break;
             };
-            let flags = bsdf.flags();
-            // A surface with both kinds of lobe (Phong glass, a mirror with a highlight) is
-            // gathered for its diffuse and glossy lobes, and the eye path goes on through its
-            // specular ones, so that what they show is seen as sharply as through pure glass.
-            let goes_on = flags.is_specular() && e <= self.max_depth;
-            if flags.is_specular() && e == self.max_depth + 1 {
+            let time = ray.time;
+            let last = e == self.max_depth + 1;
+            if last && bsdf.flags().is_specular() {
                 // The light a last vertex's specular lobes show (a lamp or the sky in a
                 // mirror), which the path tracer's last vertex also takes.
-                let ld = direct::bsdf_sample_ld(
-                    scene,
-                    &it,
-                    wo,
-                    &bsdf,
-                    wl,
-                    stream,
-                    counts,
-                    ray.time,
-                    direct::Lobes::Specular,
-                );
-                l += beta * ld;
+                let lobes = direct::Lobes::Specular;
+                l += beta
+                    * direct::bsdf_sample_ld(
+                        scene, &it, wo, &bsdf, wl, stream, counts, time, lobes,
+                    );
             }
-            if flags.is_non_specular() {
-                let time = ray.time;
+            // The diffuse part is gathered here, the rest (glossy and specular lobes) traced
+            // on, as the path tracer traces it; a last vertex is gathered whole. A sharp
+            // glossy lobe would see the maps' blur and noise, and through a specular one
+            // the maps would be looked up where the lobe points, not here.
+            let (gathered, traced) = if last {
+                (bsdf.flags().is_non_specular().then_some(bsdf), None)
+            } else {
+                bsdf.split_diffuse()
+            };
+            if let Some(g) = gathered {
                 // The gather rays are the BSDF samples MIS weighs the light sample against.
-                let n = if e <= self.max_depth {
-                    self.gather_rays as f64
-                } else {
-                    0.0
-                };
-                l += beta * sample_ld(scene, &it, wo, &bsdf, wl, stream, counts, time, n);
+                let n = if last { 0.0 } else { self.gather_rays as f64 };
+                l += beta * sample_ld(scene, &it, wo, &g, wl, stream, counts, time, n);
                 let mut found = (tree.is_some() && !self.caustic.is_empty()).then(Vec::new);
                 let (caustic, r2) =
-                    self.estimate(&self.caustic, &it, wo, &bsdf, wl, e, found.as_mut());
+                    self.estimate(&self.caustic, &it, wo, &g, wl, e, found.as_mut());
                 l += beta * caustic;
                 if let Some(photons) = found {
                     record(&mut tree, node, |n| {
@@ -207,19 +212,21 @@ impl<'a> PhotonMapper<'a> {
                         })
                     });
                 }
+                // A smooth coat's own reflection belongs to the traced part.
+                let specular = traced.is_none();
                 let gathered = self.gather(
-                    &it, wo, &bsdf, wl, stream, counts, e, time, !goes_on, &mut tree, node,
+                    &it, wo, &g, wl, stream, counts, e, time, specular, &mut tree, node,
                 );
                 l += beta * gathered;
                 record(&mut tree, node, |n| n.color = rgb(l, wl));
-                if !goes_on {
-                    break;
-                }
             }
-            if e == self.max_depth + 1 {
+            let Some(r) = traced else {
                 break;
+            };
+            if r.flags().is_non_specular() {
+                l += beta * sample_ld(scene, &it, wo, &r, wl, stream, counts, time, 1.0);
             }
-            let Some(bs) = bsdf.sample_f(
+            let Some(bs) = r.sample_f(
                 wo,
                 stream.next_1d(),
                 stream.next_2d(),
@@ -227,12 +234,11 @@ impl<'a> PhotonMapper<'a> {
             ) else {
                 break;
             };
-            // After the gather only a specular sample goes on: its weight (with its lobe's
-            // probability in the pdf) estimates the specular lobes' share.
-            if flags.is_non_specular() && !bs.is_specular() {
-                break;
-            }
             beta *= bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
+            pdf_bsdf = match bs.is_specular() {
+                true => f64::INFINITY,
+                false => direct::bsdf_pdf(&r, wo, &bs),
+            };
             if bs.is_transmission() {
                 counts.refraction += 1;
                 kind = RayKind::Refracted;
@@ -243,8 +249,8 @@ impl<'a> PhotonMapper<'a> {
             if beta.is_black() {
                 break;
             }
-            ray =
-                Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(ray.time);
+            previous = it.p;
+            ray = Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(time);
         }
         l
     }
