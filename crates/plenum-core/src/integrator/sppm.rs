@@ -62,7 +62,8 @@ const UNIT: f64 = 1.0 / 268_435_456.0;
 /// one leaves them within the noise.
 const FOOTPRINT_PIXELS: f64 = 1.0;
 
-/// Where a pixel's camera path met its first diffuse or glossy surface, this iteration.
+/// Where a pixel's camera path met its first diffuse surface (or, at its last vertex, a
+/// glossy one), this iteration.
 #[derive(Clone, Copy)]
 struct VisiblePoint {
     p: Vec3,
