@@ -55,6 +55,27 @@ pub fn draw(l: &LoadedScene, settings: &RenderSettings) -> Vec<[f32; 3]> {
     render_checked(l, settings).film.pixels().to_vec()
 }
 
+/// Asserts that each channel of the image mean `m` is within `tolerance` (relative) of
+/// `reference`'s, naming `what` and the reference's name `against` where it is not.
+pub fn assert_mean_within(
+    what: &str,
+    m: [f64; 3],
+    against: &str,
+    reference: [f64; 3],
+    tolerance: f64,
+) {
+    for c in 0..3 {
+        let rel = m[c] / reference[c] - 1.0;
+        assert!(
+            rel.abs() < tolerance,
+            "{what}: channel {c} {:.4} against {against} {:.4} ({:+.2} %)",
+            m[c],
+            reference[c],
+            100.0 * rel
+        );
+    }
+}
+
 pub fn mean(pixels: &[[f32; 3]]) -> [f64; 3] {
     let mut m = [0.0; 3];
     for p in pixels {
