@@ -15,7 +15,7 @@
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::{Film, SplatBuffer};
-use crate::integrator::{Integrator, IntegratorKind, RayCounts, RayTree, StrategyImages};
+use crate::integrator::{whole_image, Integrator, RayCounts, RayTree, StrategyImages};
 use crate::raw_film::{PixelSums, RawFilm};
 use crate::sampling::{PixelSampler, Rng, SampleStream};
 use crate::scene::Scene;
@@ -30,11 +30,11 @@ use std::time::{Duration, Instant};
 pub const TILE_SIZE: u32 = 16;
 
 /// An empty film for `settings`, to hold sample indices `samples` of every pixel (of all
-/// `settings.sampler`'s samples; ignored by adaptive sampling and the SPD corners). SPPM's
-/// film holds all its iterations.
+/// `settings.sampler`'s samples; ignored by adaptive sampling and the SPD corners). A method
+/// with a loop of its own ([`whole_image`]) gets its own film.
 pub fn new_film(settings: &RenderSettings, samples: Range<u32>) -> RawFilm {
-    if settings.integrator.kind == IntegratorKind::Sppm {
-        return crate::integrator::sppm::new_film(settings);
+    if let Some(method) = whole_image(settings.integrator.kind) {
+        return method.new_film(settings);
     }
     let extra = u32::from(settings.corners);
     let mut film = RawFilm::new(
@@ -68,17 +68,15 @@ pub fn render(
 }
 
 /// Renders into `film` (from [`new_film`], or a checkpoint of the same scene and settings):
-/// the pixels it does not yet hold in full (SPPM: the iterations), then the image of all it
-/// holds.
+/// the pixels it does not yet hold in full, then the image of all it holds.
 pub fn render_film(
     scene: &Scene,
     settings: &RenderSettings,
     film: &mut RawFilm,
     mut control: RenderControl,
 ) -> RenderOutput {
-    // SPPM's iterations do not fit the per-pixel loop: it has its own.
-    if settings.integrator.kind == IntegratorKind::Sppm {
-        return crate::integrator::sppm::render_film(scene, settings, film, control);
+    if let Some(method) = whole_image(settings.integrator.kind) {
+        return method.render_film(scene, settings, film, control);
     }
     // Splats are pixel values once divided by the light paths per pixel; the camera's
     // importance reaches as far beyond the image as the filter spreads them.
@@ -92,16 +90,14 @@ pub fn render_film(
     splats.preload(&film.splats);
     let camera =
         Camera::new(&scene.camera, settings.width, settings.height).with_margin(splats.margin());
-    let strategies = (settings.integrator.strategies
-        && settings.integrator.kind == IntegratorKind::Bdpt)
-        .then(|| {
-            StrategyImages::new(
-                settings.width,
-                settings.height,
-                1.0 / spp as f64,
-                settings.integrator.max_depth,
-            )
-        });
+    let strategies = settings.integrator.writes_strategies().then(|| {
+        StrategyImages::new(
+            settings.width,
+            settings.height,
+            1.0 / spp as f64,
+            settings.integrator.max_depth,
+        )
+    });
     let integrator = Integrator::new(
         scene,
         &settings.integrator,
@@ -545,11 +541,11 @@ fn corner_stream(seed: u64, x: u32, y: u32) -> SampleStream {
     SampleStream::random(Rng::for_sample(seed, x, y, u32::MAX))
 }
 
-/// The ray tree of one pixel: every ray of every sample, and the pixel's colour (SPPM: its
-/// first iteration, [`crate::integrator::sppm::trace_pixel`]).
+/// The ray tree of one pixel: every ray of every sample, and the pixel's colour (a method
+/// with a loop of its own says what it traces for a pixel).
 pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> (RayTree, Color) {
-    if settings.integrator.kind == IntegratorKind::Sppm {
-        return crate::integrator::sppm::trace_pixel(scene, settings, x, y);
+    if let Some(method) = whole_image(settings.integrator.kind) {
+        return method.trace_pixel(scene, settings, x, y);
     }
     let splats =
         SplatBuffer::new(settings.width, settings.height, 1.0).with_filter(&settings.filter);

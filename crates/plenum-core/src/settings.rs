@@ -99,6 +99,13 @@ pub struct IntegratorConfig {
     pub photon: PhotonConfig,
 }
 
+impl IntegratorConfig {
+    /// Whether the render keeps each strategy's image (a method with strategies, asked to).
+    pub fn writes_strategies(&self) -> bool {
+        self.strategies && self.kind == IntegratorKind::Bdpt
+    }
+}
+
 /// The settings of the photon methods (`photon`, `sppm`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PhotonConfig {

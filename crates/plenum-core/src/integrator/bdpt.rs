@@ -190,7 +190,7 @@ pub struct BidirectionalPathTracer<'a> {
     strategies: Option<&'a StrategyImages>,
     max_depth: u32,
     rr_depth: u32,
-    color: ColorMode,
+    pub(super) color: ColorMode,
     center: Vec3,
     radius: f64,
 }
@@ -237,30 +237,31 @@ impl<'a> BidirectionalPathTracer<'a> {
         }
     }
 
-    /// The pixel's estimate from every strategy with t ≥ 2; the t = 1 strategies splat.
-    pub fn camera_ray(
+    /// The pixel's estimate from every strategy with t ≥ 2, at the wavelengths `wl` (which
+    /// a dispersive bounce may reduce to the hero wavelength); the t = 1 strategies splat.
+    pub(super) fn li(
         &self,
         ray: &Ray,
+        wl: &mut SampledWavelengths,
         stream: &mut SampleStream,
         counts: &mut RayCounts,
         tree: Option<&mut RayTree>,
-    ) -> Color {
+    ) -> SampledSpectrum {
         SCRATCH.with(|s| {
             let mut s = s.borrow_mut();
-            self.sample(ray, stream, counts, tree, &mut s)
+            self.sample(ray, wl, stream, counts, tree, &mut s)
         })
     }
 
     fn sample(
         &self,
         ray: &Ray,
+        wl: &mut SampledWavelengths,
         stream: &mut SampleStream,
         counts: &mut RayCounts,
         mut tree: Option<&mut RayTree>,
         scratch: &mut Scratch,
-    ) -> Color {
-        counts.camera += 1;
-        let mut wl = super::sample_wavelengths(self.color, stream);
+    ) -> SampledSpectrum {
         let Scratch {
             camera: camera_path,
             light: light_path,
@@ -271,10 +272,10 @@ impl<'a> BidirectionalPathTracer<'a> {
         splats.clear();
         let raster = self.camera.we(ray).map(|(_, r)| r);
         let max_surface = self.max_depth as usize + 1;
-        self.camera_subpath(ray, max_surface + 2, &mut wl, stream, counts, camera_path);
-        self.light_subpath(ray.time, max_surface, &mut wl, stream, counts, light_path);
-        record_subpath(&mut tree, camera_path, RayKind::Camera, &wl);
-        record_subpath(&mut tree, light_path, RayKind::Light, &wl);
+        self.camera_subpath(ray, max_surface + 2, wl, stream, counts, camera_path);
+        self.light_subpath(ray.time, max_surface, wl, stream, counts, light_path);
+        record_subpath(&mut tree, camera_path, RayKind::Camera, wl);
+        record_subpath(&mut tree, light_path, RayKind::Light, wl);
 
         let mut l = SampledSpectrum::ZERO;
         // Emission no light stands for, Phong k_e, by s = 0 alone (the background is a
@@ -289,7 +290,7 @@ impl<'a> BidirectionalPathTracer<'a> {
                     continue;
                 }
                 let Some((c, weight, splat_at)) =
-                    self.connect(light_path, camera_path, s, t, &wl, ray.time, stream, counts)
+                    self.connect(light_path, camera_path, s, t, wl, ray.time, stream, counts)
                 else {
                     continue;
                 };
@@ -300,8 +301,8 @@ impl<'a> BidirectionalPathTracer<'a> {
                         l += c * weight;
                         if let (Some(si), Some(r)) = (self.strategies, raster) {
                             let (weighted, plain) = &si.images[index];
-                            weighted.add(r, rgb(c * weight, &wl));
-                            plain.add(r, rgb(c, &wl));
+                            weighted.add(r, rgb(c * weight, wl));
+                            plain.add(r, rgb(c, wl));
                         }
                     }
                 }
@@ -320,9 +321,9 @@ impl<'a> BidirectionalPathTracer<'a> {
                         s: s as u32,
                         t: t as u32,
                         mis_weight: weight,
-                        unweighted: rgb(c, &wl),
+                        unweighted: rgb(c, wl),
                     });
-                    node.color = rgb(c * weight, &wl);
+                    node.color = rgb(c * weight, wl);
                     tr.push(node);
                 }
             }
@@ -330,7 +331,7 @@ impl<'a> BidirectionalPathTracer<'a> {
         // The wavelengths are final only now (a dispersive bounce on either subpath may
         // have kept the hero alone), so splats are turned into colour here.
         for &(r, c, index, weight) in splats.iter() {
-            let v = rgb(c * weight, &wl);
+            let v = rgb(c * weight, wl);
             if !(v.r.is_finite() && v.g.is_finite() && v.b.is_finite()) {
                 counts.invalid += 1;
                 continue;
@@ -339,15 +340,10 @@ impl<'a> BidirectionalPathTracer<'a> {
             if let Some(si) = self.strategies {
                 let (weighted, plain) = &si.images[index];
                 weighted.add(r, v);
-                plain.add(r, rgb(c, &wl));
+                plain.add(r, rgb(c, wl));
             }
         }
-        let c = rgb(l, &wl);
-        if !(c.r.is_finite() && c.g.is_finite() && c.b.is_finite()) {
-            counts.invalid += 1;
-            return Color::BLACK;
-        }
-        c
+        l
     }
 
     /// The camera subpath: the lens point, then up to `max_vertices` − 1 more.

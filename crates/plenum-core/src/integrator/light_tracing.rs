@@ -36,7 +36,7 @@ pub struct LightTracer<'a> {
     splats: &'a SplatBuffer,
     max_depth: u32,
     rr_depth: u32,
-    color: ColorMode,
+    pub(super) color: ColorMode,
     center: Vec3,
     radius: f64,
 }
@@ -61,21 +61,9 @@ impl<'a> LightTracer<'a> {
         }
     }
 
-    /// Traces one light path for this pixel sample and splats what reaches the camera; the
-    /// pixel's own estimate is black.
-    pub fn camera_ray(
-        &self,
-        ray: &Ray,
-        stream: &mut SampleStream,
-        counts: &mut RayCounts,
-        tree: Option<&mut RayTree>,
-    ) -> Color {
-        let mut wl = super::sample_wavelengths(self.color, stream);
-        self.light_path(ray.time, &mut wl, stream, counts, tree);
-        Color::BLACK
-    }
-
-    fn light_path(
+    /// Traces one light path for a pixel sample, at the wavelengths `wl`, and splats what
+    /// reaches the camera; the pixel's own estimate is black.
+    pub(super) fn light_path(
         &self,
         time: f64,
         wl: &mut SampledWavelengths,

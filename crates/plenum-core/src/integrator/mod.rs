@@ -3,6 +3,9 @@
 //! The render loop ([`crate::render`]) does not know which integrator it drives: it asks
 //! [`Integrator::camera_ray`] for each camera sample (pbrt-v4's `RayIntegrator::Li` under its
 //! `ImageTileIntegrator`). The integrator is chosen once per render, and dispatched by `match`.
+//! A method whose image is not a sum of pixel samples (SPPM's iterations) renders by a loop
+//! of its own, which the render loop finds through [`whole_image`] (pbrt-v4's integrators
+//! that override `Render`).
 
 mod bdpt;
 mod direct;
@@ -13,7 +16,7 @@ mod photon;
 pub mod photon_map;
 mod photons;
 mod ray_tree;
-pub mod sppm;
+mod sppm;
 mod whitted;
 
 pub use bdpt::{BidirectionalPathTracer, StrategyImages};
@@ -30,12 +33,14 @@ use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::SplatBuffer;
 use crate::math::Ray;
+use crate::raw_film::RawFilm;
 use crate::sampling::SampleStream;
 use crate::scene::Scene;
 pub use crate::settings::{
     ColorMode, IntegratorConfig, IntegratorKind, PhotonConfig, RayCounts, MAX_DEPTH, MAX_NEAREST,
 };
-use plenum_spectrum::SampledWavelengths;
+use crate::settings::{RenderControl, RenderOutput, RenderSettings};
+use plenum_spectrum::{SampledSpectrum, SampledWavelengths};
 
 impl IntegratorKind {
     /// The method a scene renders with unless told: `path` for a scene of physically
@@ -58,6 +63,39 @@ pub(crate) fn sample_wavelengths(
     match color {
         ColorMode::Spectral => SampledWavelengths::sample_visible(stream.next_1d()),
         ColorMode::Rgb => SampledWavelengths::rgb(),
+    }
+}
+
+/// A method that renders the whole image by a loop of its own rather than pixel sample by
+/// pixel sample: the film it needs, the render into it, and the ray tree of one pixel.
+pub trait WholeImage: Sync {
+    /// An empty film for `settings`.
+    fn new_film(&self, settings: &RenderSettings) -> RawFilm;
+    /// Renders what `film` (from `new_film`, or a checkpoint of it) does not yet hold, then
+    /// the image of all it holds.
+    fn render_film(
+        &self,
+        scene: &Scene,
+        settings: &RenderSettings,
+        film: &mut RawFilm,
+        control: RenderControl,
+    ) -> RenderOutput;
+    /// The ray tree of pixel (x, y), and the pixel's colour.
+    fn trace_pixel(
+        &self,
+        scene: &Scene,
+        settings: &RenderSettings,
+        x: u32,
+        y: u32,
+    ) -> (RayTree, Color);
+}
+
+/// The loop of its own that method `kind` renders by; `None` for a method whose pixels are
+/// sums of pixel samples, which [`Integrator`] evaluates.
+pub fn whole_image(kind: IntegratorKind) -> Option<&'static dyn WholeImage> {
+    match kind {
+        IntegratorKind::Sppm => Some(&sppm::Sppm),
+        _ => None,
     }
 }
 
@@ -93,8 +131,8 @@ impl<'a> Integrator<'a> {
             IntegratorKind::Bdpt => Integrator::Bdpt(BidirectionalPathTracer::new(
                 scene, config, camera, splats, strategies,
             )),
-            // SPPM renders by its own loop (`sppm::render`); its nearest relative here serves
-            // trace-pixel, which follows one camera sample.
+            // SPPM renders by its own loop ([`whole_image`]); were it asked for pixel samples,
+            // its nearest relative would give them.
             IntegratorKind::Photon | IntegratorKind::Sppm => {
                 Integrator::Photon(Box::new(PhotonMapper::new(scene, config, camera, seed)))
             }
@@ -103,6 +141,11 @@ impl<'a> Integrator<'a> {
 
     /// Linear sRGB radiance along a camera ray; `stream` gives the random numbers of its pixel
     /// sample. With `tree`, every ray traced is recorded in it.
+    ///
+    /// Every method's pixel sample is evaluated here alike: its wavelengths are the stream's
+    /// next number (spectral mode, so that the sampler stratifies them across the pixel's
+    /// samples), its radiance comes from the method, and a value that is not finite counts
+    /// as invalid and adds black.
     #[inline]
     pub fn camera_ray(
         &self,
@@ -111,12 +154,48 @@ impl<'a> Integrator<'a> {
         counts: &mut RayCounts,
         tree: Option<&mut RayTree>,
     ) -> Color {
+        let mut wl = sample_wavelengths(self.color(), stream);
+        let l = match self {
+            // Whitted's model is RGB, its tree of colours.
+            Integrator::Whitted(w) => {
+                counts.camera += 1;
+                let c = w.camera_ray(ray, stream, counts, tree);
+                SampledSpectrum([c.r, c.g, c.b, 0.0])
+            }
+            Integrator::Path(p) => {
+                counts.camera += 1;
+                p.li(ray, &mut wl, stream, counts, tree)
+            }
+            // A light path per sample; what reaches the camera is splatted.
+            Integrator::Light(l) => {
+                l.light_path(ray.time, &mut wl, stream, counts, tree);
+                SampledSpectrum::ZERO
+            }
+            Integrator::Bdpt(b) => {
+                counts.camera += 1;
+                b.li(ray, &mut wl, stream, counts, tree)
+            }
+            Integrator::Photon(p) => {
+                counts.camera += 1;
+                p.li(ray, &mut wl, stream, counts, tree)
+            }
+        };
+        let [r, g, b] = l.to_linear_srgb(&wl);
+        if !(r.is_finite() && g.is_finite() && b.is_finite()) {
+            counts.invalid += 1;
+            return Color::BLACK;
+        }
+        Color::new(r, g, b)
+    }
+
+    /// How the method represents light.
+    fn color(&self) -> ColorMode {
         match self {
-            Integrator::Whitted(w) => w.camera_ray(ray, stream, counts, tree),
-            Integrator::Path(p) => p.camera_ray(ray, stream, counts, tree),
-            Integrator::Light(l) => l.camera_ray(ray, stream, counts, tree),
-            Integrator::Bdpt(b) => b.camera_ray(ray, stream, counts, tree),
-            Integrator::Photon(p) => p.camera_ray(ray, stream, counts, tree),
+            Integrator::Whitted(_) => ColorMode::Rgb,
+            Integrator::Path(p) => p.color,
+            Integrator::Light(l) => l.color,
+            Integrator::Bdpt(b) => b.color,
+            Integrator::Photon(p) => p.color,
         }
     }
 

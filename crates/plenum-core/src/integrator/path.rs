@@ -26,7 +26,7 @@ pub struct PathTracer<'a> {
     scene: &'a Scene,
     max_depth: u32,
     rr_depth: u32,
-    color: ColorMode,
+    pub(super) color: ColorMode,
 }
 
 impl<'a> PathTracer<'a> {
@@ -39,34 +39,9 @@ impl<'a> PathTracer<'a> {
         }
     }
 
-    /// Linear sRGB radiance along a camera ray. The wavelengths are the stream's next number
-    /// (spectral mode), so the sampler stratifies them across the pixel's samples.
-    pub fn camera_ray(
-        &self,
-        ray: &Ray,
-        stream: &mut SampleStream,
-        counts: &mut RayCounts,
-        tree: Option<&mut RayTree>,
-    ) -> Color {
-        counts.camera += 1;
-        let mut wl = super::sample_wavelengths(self.color, stream);
-        let l = self.li(ray, &mut wl, stream, counts, tree);
-        if !l.is_finite() {
-            counts.invalid += 1;
-            return Color::BLACK;
-        }
-        let [r, g, b] = l.to_linear_srgb(&wl);
-        let c = Color::new(r, g, b);
-        if !(r.is_finite() && g.is_finite() && b.is_finite()) {
-            counts.invalid += 1;
-            return Color::BLACK;
-        }
-        c
-    }
-
     /// The radiance of the path started by `ray`, at the wavelengths `wl` (which a
     /// dispersive refraction may reduce to the hero wavelength).
-    fn li(
+    pub(super) fn li(
         &self,
         camera_ray: &Ray,
         wl: &mut SampledWavelengths,

@@ -53,7 +53,7 @@ const CHUNK: u64 = 4096;
 pub struct PhotonMapper<'a> {
     scene: &'a Scene,
     max_depth: u32,
-    color: ColorMode,
+    pub(super) color: ColorMode,
     nearest: usize,
     max_distance2: f32,
     gather_rays: u32,
@@ -108,26 +108,9 @@ impl<'a> PhotonMapper<'a> {
         (self.global.len(), self.caustic.len())
     }
 
-    /// Linear sRGB radiance along a camera ray.
-    pub fn camera_ray(
-        &self,
-        ray: &Ray,
-        stream: &mut SampleStream,
-        counts: &mut RayCounts,
-        tree: Option<&mut RayTree>,
-    ) -> Color {
-        counts.camera += 1;
-        let mut wl = super::sample_wavelengths(self.color, stream);
-        let l = self.li(ray, &mut wl, stream, counts, tree);
-        let c = rgb(l, &wl);
-        if !(l.is_finite() && c.r.is_finite() && c.g.is_finite() && c.b.is_finite()) {
-            counts.invalid += 1;
-            return Color::BLACK;
-        }
-        c
-    }
-
-    fn li(
+    /// The radiance along a camera ray, at the wavelengths `wl` (which a dispersive
+    /// refraction may reduce to the hero wavelength).
+    pub(super) fn li(
         &self,
         camera_ray: &Ray,
         wl: &mut SampledWavelengths,

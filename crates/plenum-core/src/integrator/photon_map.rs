@@ -62,7 +62,7 @@ pub struct Query {
     pub k: usize,
     /// The largest squared distance searched.
     pub max_distance2: f32,
-    /// Photons deeper than this are left out (see [`super::photons`] on depth).
+    /// Photons deeper than this are left out (see `photons.rs` on depth).
     pub max_depth: u16,
 }
 

@@ -38,6 +38,7 @@ use super::light_tracing::rgb;
 use super::photons::{Arrival, PhotonTracer};
 use super::{
     record, record_hit, FoundPhoton, PhotonGather, RayCounts, RayKind, RayNode, RayTree, Stop,
+    WholeImage,
 };
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
@@ -122,75 +123,79 @@ struct PhotonSums {
     m: AtomicU64,
 }
 
-/// An empty SPPM film for `settings`: its iterations are the sampler's samples per pixel.
-pub fn new_film(settings: &RenderSettings) -> RawFilm {
-    RawFilm::progressive(
-        settings.width,
-        settings.height,
-        settings.sampler.samples_per_pixel().max(1),
-        photons_per_iteration(settings),
-    )
-}
+/// SPPM's iterations do not fit the per-pixel loop: it renders by a loop of its own.
+pub struct Sppm;
 
-/// Renders the iterations `film` (from [`new_film`], or a checkpoint of it) does not yet
-/// hold. `control.cancel` stops it between iterations, `control.progress(done, total)` is
-/// called after each, and a checkpoint, when due, is taken between them.
-pub fn render_film(
-    scene: &Scene,
-    settings: &RenderSettings,
-    film: &mut RawFilm,
-    control: RenderControl,
-) -> RenderOutput {
-    let (w, h) = (settings.width, settings.height);
-    let camera = Camera::new(&scene.camera, w, h);
-    let config = &settings.integrator;
-    let iterations = film.samples.end;
-    let state = film
-        .progressive
-        .as_mut()
-        .expect("an SPPM film, from sppm::new_film");
-    let photons = state.photons_per_iteration;
-    let alpha = config.photon.alpha;
-    let tracer = PhotonTracer::new(scene, config);
-    let mut pixels: Vec<PixelState> = state
-        .pixels
-        .iter()
-        .map(|&stats| PixelState { stats, vp: None })
-        .collect();
-    let sums: Vec<PhotonSums> = (0..pixels.len()).map(|_| PhotonSums::default()).collect();
-    let mut grid = Grid::default();
-    let mut counts = RayCounts::default();
-    let mut checkpoint = control.checkpoint;
-    let mut last_checkpoint = Instant::now();
-    let mut done = state.iterations;
-    for iteration in done..iterations {
-        if control.cancel.load(Ordering::Relaxed) {
-            break;
-        }
-        let wl = iteration_wavelengths(settings, iteration);
-        let eye = Eye {
-            scene,
-            camera: &camera,
-            settings,
-            wl,
-            iteration,
-        };
-        let c = pixels
-            .par_iter_mut()
-            .enumerate()
-            .fold(RayCounts::default, |mut c, (i, px)| {
-                eye.camera_path(i as u32 % w, i as u32 / w, px, &mut c, None);
-                c
-            })
-            .reduce(RayCounts::default, add_counts);
-        counts.add(&c);
+impl WholeImage for Sppm {
+    /// An empty SPPM film for `settings`: its iterations are the sampler's samples per pixel.
+    fn new_film(&self, settings: &RenderSettings) -> RawFilm {
+        RawFilm::progressive(
+            settings.width,
+            settings.height,
+            settings.sampler.samples_per_pixel().max(1),
+            photons_per_iteration(settings),
+        )
+    }
 
-        grid.build(&pixels);
-        let max_depth = config.max_depth;
-        let pixels_now = &pixels;
-        let grid_now = &grid;
-        let c =
-            (0..photons.div_ceil(CHUNK))
+    /// Renders the iterations `film` (from `new_film`, or a checkpoint of it) does not yet
+    /// hold. `control.cancel` stops it between iterations, `control.progress(done, total)` is
+    /// called after each, and a checkpoint, when due, is taken between them.
+    fn render_film(
+        &self,
+        scene: &Scene,
+        settings: &RenderSettings,
+        film: &mut RawFilm,
+        control: RenderControl,
+    ) -> RenderOutput {
+        let (w, h) = (settings.width, settings.height);
+        let camera = Camera::new(&scene.camera, w, h);
+        let config = &settings.integrator;
+        let iterations = film.samples.end;
+        let state = film
+            .progressive
+            .as_mut()
+            .expect("an SPPM film, from Sppm::new_film");
+        let photons = state.photons_per_iteration;
+        let alpha = config.photon.alpha;
+        let tracer = PhotonTracer::new(scene, config);
+        let mut pixels: Vec<PixelState> = state
+            .pixels
+            .iter()
+            .map(|&stats| PixelState { stats, vp: None })
+            .collect();
+        let sums: Vec<PhotonSums> = (0..pixels.len()).map(|_| PhotonSums::default()).collect();
+        let mut grid = Grid::default();
+        let mut counts = RayCounts::default();
+        let mut checkpoint = control.checkpoint;
+        let mut last_checkpoint = Instant::now();
+        let mut done = state.iterations;
+        for iteration in done..iterations {
+            if control.cancel.load(Ordering::Relaxed) {
+                break;
+            }
+            let wl = iteration_wavelengths(settings, iteration);
+            let eye = Eye {
+                scene,
+                camera: &camera,
+                settings,
+                wl,
+                iteration,
+            };
+            let c = pixels
+                .par_iter_mut()
+                .enumerate()
+                .fold(RayCounts::default, |mut c, (i, px)| {
+                    eye.camera_path(i as u32 % w, i as u32 / w, px, &mut c, None);
+                    c
+                })
+                .reduce(RayCounts::default, add_counts);
+            counts.add(&c);
+
+            grid.build(&pixels);
+            let max_depth = config.max_depth;
+            let pixels_now = &pixels;
+            let grid_now = &grid;
+            let c = (0..photons.div_ceil(CHUNK))
                 .into_par_iter()
                 .map(|chunk| {
                     let mut c = RayCounts::default();
@@ -227,42 +232,119 @@ pub fn render_film(
                     c
                 })
                 .reduce(RayCounts::default, add_counts);
-        counts.add(&c);
+            counts.add(&c);
 
-        pixels.par_iter_mut().zip(&sums).for_each(|(px, s)| {
-            let m = s.m.swap(0, Ordering::Relaxed) as f64;
-            let phi = s
-                .phi
-                .each_ref()
-                .map(|v| v.swap(0, Ordering::Relaxed) as f64 * UNIT);
-            let k = &mut px.stats;
-            if m > 0.0 {
-                let n = k.photons + alpha * m;
-                let shrink2 = n / (k.photons + m);
-                for (tau, phi) in k.flux.iter_mut().zip(phi) {
-                    *tau = (*tau + phi) * shrink2;
+            pixels.par_iter_mut().zip(&sums).for_each(|(px, s)| {
+                let m = s.m.swap(0, Ordering::Relaxed) as f64;
+                let phi = s
+                    .phi
+                    .each_ref()
+                    .map(|v| v.swap(0, Ordering::Relaxed) as f64 * UNIT);
+                let k = &mut px.stats;
+                if m > 0.0 {
+                    let n = k.photons + alpha * m;
+                    let shrink2 = n / (k.photons + m);
+                    for (tau, phi) in k.flux.iter_mut().zip(phi) {
+                        *tau = (*tau + phi) * shrink2;
+                    }
+                    k.photons = n;
+                    k.radius *= shrink2.sqrt();
                 }
-                k.photons = n;
-                k.radius *= shrink2.sqrt();
-            }
-            px.vp = None;
-        });
-        done = iteration + 1;
-        (control.progress)(done as usize, iterations as usize);
-        if let Some((every, save)) = checkpoint.as_mut() {
-            if done < iterations && last_checkpoint.elapsed() >= *every {
-                keep(film, &pixels, done);
-                save(film);
-                last_checkpoint = Instant::now();
+                px.vp = None;
+            });
+            done = iteration + 1;
+            (control.progress)(done as usize, iterations as usize);
+            if let Some((every, save)) = checkpoint.as_mut() {
+                if done < iterations && last_checkpoint.elapsed() >= *every {
+                    keep(film, &pixels, done);
+                    save(film);
+                    last_checkpoint = Instant::now();
+                }
             }
         }
+        keep(film, &pixels, done);
+        RenderOutput {
+            film: film.image(),
+            counts,
+            complete: film.is_complete(1),
+            strategies: Vec::new(),
+        }
     }
-    keep(film, &pixels, done);
-    RenderOutput {
-        film: film.image(),
-        counts,
-        complete: film.is_complete(1),
-        strategies: Vec::new(),
+
+    /// The ray tree of pixel (x, y) in SPPM's first iteration: its camera path to the visible
+    /// point, and every photon of the first photon pass that landed within the pixel's radius
+    /// there. The colour is the pixel's estimate after that one iteration.
+    fn trace_pixel(
+        &self,
+        scene: &Scene,
+        settings: &RenderSettings,
+        x: u32,
+        y: u32,
+    ) -> (RayTree, Color) {
+        let camera = Camera::new(&scene.camera, settings.width, settings.height);
+        let wl = iteration_wavelengths(settings, 0);
+        let eye = Eye {
+            scene,
+            camera: &camera,
+            settings,
+            wl,
+            iteration: 0,
+        };
+        let mut px = PixelState::default();
+        let mut tree = RayTree::default();
+        let mut counts = RayCounts::default();
+        eye.camera_path(x, y, &mut px, &mut counts, Some(&mut tree));
+        let ld = Color::new(px.stats.direct[0], px.stats.direct[1], px.stats.direct[2]);
+        let Some(vp) = px.vp else {
+            return (tree, ld);
+        };
+        let photons = photons_per_iteration(settings);
+        let tracer = PhotonTracer::new(scene, &settings.integrator);
+        let max_depth = settings.integrator.max_depth;
+        let chunks: Vec<Vec<(FoundPhoton, Color)>> = (0..photons.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|chunk| {
+                let (mut found, mut c) = (Vec::new(), RayCounts::default());
+                for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(photons) {
+                    let mut stream = PhotonTracer::stream(settings.seed, 0, index);
+                    let mut photon_wl = wl;
+                    let time = camera.time(stream.next_1d());
+                    tracer.trace(time, &mut photon_wl, &mut stream, &mut c, |a, pwl| {
+                        if a.depth >= 2 {
+                            if let Some(phi) = vp.photon_flux(px.stats.radius, a, pwl, max_depth) {
+                                let photon = FoundPhoton {
+                                    position: a.it.p,
+                                    wi: a.wi,
+                                    power: rgb(a.beta / photons as f64, pwl),
+                                    distance: (a.it.p - vp.p).length(),
+                                };
+                                found.push((photon, phi));
+                            }
+                        }
+                        true
+                    });
+                }
+                found
+            })
+            .collect();
+        let mut found: Vec<(FoundPhoton, Color)> = chunks.into_iter().flatten().collect();
+        found.sort_by(|a, b| a.0.distance.total_cmp(&b.0.distance));
+        let phi = found.iter().fold(Color::BLACK, |s, (_, f)| s + *f);
+        let estimate = phi
+            * (1.0 / (photons as f64 * std::f64::consts::PI * px.stats.radius * px.stats.radius));
+        if let Some(node) = tree.nodes.last_mut() {
+            node.photons = Some(PhotonGather {
+                source: "SPPM photon pass",
+                radius: px.stats.radius,
+                photons: found.into_iter().map(|(p, _)| p).collect(),
+                estimate,
+            });
+        }
+        let color = ld + estimate;
+        if let Some(root) = tree.nodes.first_mut() {
+            root.color = color;
+        }
+        (tree, color)
     }
 }
 
@@ -294,76 +376,6 @@ fn photons_per_iteration(settings: &RenderSettings) -> u64 {
         0 => settings.width as u64 * settings.height as u64,
         n => n,
     }
-}
-
-/// The ray tree of pixel (x, y) in SPPM's first iteration: its camera path to the visible
-/// point, and every photon of the first photon pass that landed within the pixel's radius
-/// there. The colour is the pixel's estimate after that one iteration.
-pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> (RayTree, Color) {
-    let camera = Camera::new(&scene.camera, settings.width, settings.height);
-    let wl = iteration_wavelengths(settings, 0);
-    let eye = Eye {
-        scene,
-        camera: &camera,
-        settings,
-        wl,
-        iteration: 0,
-    };
-    let mut px = PixelState::default();
-    let mut tree = RayTree::default();
-    let mut counts = RayCounts::default();
-    eye.camera_path(x, y, &mut px, &mut counts, Some(&mut tree));
-    let ld = Color::new(px.stats.direct[0], px.stats.direct[1], px.stats.direct[2]);
-    let Some(vp) = px.vp else {
-        return (tree, ld);
-    };
-    let photons = photons_per_iteration(settings);
-    let tracer = PhotonTracer::new(scene, &settings.integrator);
-    let max_depth = settings.integrator.max_depth;
-    let chunks: Vec<Vec<(FoundPhoton, Color)>> = (0..photons.div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|chunk| {
-            let (mut found, mut c) = (Vec::new(), RayCounts::default());
-            for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(photons) {
-                let mut stream = PhotonTracer::stream(settings.seed, 0, index);
-                let mut photon_wl = wl;
-                let time = camera.time(stream.next_1d());
-                tracer.trace(time, &mut photon_wl, &mut stream, &mut c, |a, pwl| {
-                    if a.depth >= 2 {
-                        if let Some(phi) = vp.photon_flux(px.stats.radius, a, pwl, max_depth) {
-                            let photon = FoundPhoton {
-                                position: a.it.p,
-                                wi: a.wi,
-                                power: rgb(a.beta / photons as f64, pwl),
-                                distance: (a.it.p - vp.p).length(),
-                            };
-                            found.push((photon, phi));
-                        }
-                    }
-                    true
-                });
-            }
-            found
-        })
-        .collect();
-    let mut found: Vec<(FoundPhoton, Color)> = chunks.into_iter().flatten().collect();
-    found.sort_by(|a, b| a.0.distance.total_cmp(&b.0.distance));
-    let phi = found.iter().fold(Color::BLACK, |s, (_, f)| s + *f);
-    let estimate =
-        phi * (1.0 / (photons as f64 * std::f64::consts::PI * px.stats.radius * px.stats.radius));
-    if let Some(node) = tree.nodes.last_mut() {
-        node.photons = Some(PhotonGather {
-            source: "SPPM photon pass",
-            radius: px.stats.radius,
-            photons: found.into_iter().map(|(p, _)| p).collect(),
-            estimate,
-        });
-    }
-    let color = ld + estimate;
-    if let Some(root) = tree.nodes.first_mut() {
-        root.color = color;
-    }
-    (tree, color)
 }
 
 fn add_counts(mut a: RayCounts, b: RayCounts) -> RayCounts {

@@ -30,7 +30,7 @@ use crate::scene::{Interaction, Scene};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WhittedConfig {
     /// Bounces of reflection and refraction after the camera ray (0: direct light only);
-    /// at most [`MAX_DEPTH`].
+    /// at most [`crate::settings::MAX_DEPTH`].
     pub max_depth: u32,
     /// Rays whose weight in the pixel (largest RGB component) falls below this are not traced.
     pub min_weight: f64,
@@ -86,7 +86,6 @@ impl<'a> Whitted<'a> {
         counts: &mut RayCounts,
         tree: Option<&mut RayTree>,
     ) -> Color {
-        counts.camera += 1;
         let branch = Branch {
             kind: RayKind::Camera,
             depth: 0,
