@@ -425,9 +425,111 @@ fn unbounded_fit(rgb: [f64; 3]) -> (f64, RgbSigmoid) {
     }
 }
 
+/// Linear sRGB of any sign as emitted radiance, linearly: r·B_r + g·B_g + b·B_b, three fixed
+/// spectra whose colours ([`illuminant_to_rgb`]) are exactly the sRGB primaries (the uplifted
+/// primaries, mixed by the inverse of their matrix of colours).
+///
+/// [`Spectrum::rgb_illuminant`] fits one smooth spectrum to each colour and clamps negative
+/// channels: right for a light's colour, wrong for estimates, such as a photon's flux seen
+/// at four wavelengths, that leave the gamut one by one and come back only summed. The basis
+/// keeps sums (the spectrum of a sum of colours is the sum of their spectra), so a sum of
+/// such estimates has the colour of the sum.
+#[derive(Clone, Copy, Debug)]
+pub struct RgbIlluminantBasis([SampledSpectrum; 3]);
+
+impl RgbIlluminantBasis {
+    /// The basis at the sample's wavelengths; in RGB mode the three lanes themselves.
+    pub fn at(wl: &SampledWavelengths) -> Self {
+        if wl.is_rgb() {
+            let lane = |k: usize| {
+                let mut s = SampledSpectrum::ZERO;
+                s[k] = 1.0;
+                s
+            };
+            return RgbIlluminantBasis([lane(0), lane(1), lane(2)]);
+        }
+        let (primaries, mix) = primaries_and_mix();
+        let p = primaries.each_ref().map(|s| s.sample(wl));
+        RgbIlluminantBasis(
+            [0, 1, 2].map(|k| p[0] * mix[0][k] + p[1] * mix[1][k] + p[2] * mix[2][k]),
+        )
+    }
+
+    /// The spectrum of linear sRGB `rgb`.
+    #[inline]
+    pub fn spectrum(&self, rgb: [f64; 3]) -> SampledSpectrum {
+        self.0[0] * rgb[0] + self.0[1] * rgb[1] + self.0[2] * rgb[2]
+    }
+}
+
+/// The uplifted sRGB primaries P_j and the inverse of their colours' matrix
+/// M[i][j] = rgb(P_j)[i], so that B_k = Σ_j P_j·M⁻¹[j][k] has colour e_k.
+fn primaries_and_mix() -> &'static ([Spectrum; 3], [[f64; 3]; 3]) {
+    static BASIS: OnceLock<([Spectrum; 3], [[f64; 3]; 3])> = OnceLock::new();
+    BASIS.get_or_init(|| {
+        let primaries =
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]].map(Spectrum::rgb_illuminant);
+        let colours = primaries
+            .each_ref()
+            .map(|p| illuminant_to_rgb(|l| p.eval(l)));
+        let m = [0, 1, 2].map(|i| [0, 1, 2].map(|j| colours[j][i]));
+        (primaries, inverse3(&m))
+    })
+}
+
+/// The inverse of a 3×3 matrix by its cofactors (the uplifted primaries' matrix is close to
+/// the identity, far from singular).
+fn inverse3(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let c = |i: usize, j: usize| {
+        let (i1, i2, j1, j2) = ((i + 1) % 3, (i + 2) % 3, (j + 1) % 3, (j + 2) % 3);
+        m[i1][j1] * m[i2][j2] - m[i1][j2] * m[i2][j1]
+    };
+    let det = m[0][0] * c(0, 0) + m[0][1] * c(0, 1) + m[0][2] * c(0, 2);
+    // The cyclic cofactors carry their signs; the inverse is their transpose over det.
+    [0, 1, 2].map(|i| [0, 1, 2].map(|j| c(j, i) / det))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_illuminant_basis_keeps_colours_of_any_sign() {
+        // Colour of r·B_r + g·B_g + b·B_b, integrated at 1 nm: (r, g, b) itself, also with
+        // negative channels; the samples are the basis at their wavelengths, and add as the
+        // colours do.
+        let (primaries, mix) = primaries_and_mix();
+        let basis_at = |l: f64, rgb: [f64; 3]| {
+            let p = primaries.each_ref().map(|s| s.eval(l));
+            (0..3)
+                .map(|k| rgb[k] * (0..3).map(|j| p[j] * mix[j][k]).sum::<f64>())
+                .sum::<f64>()
+        };
+        let colour = |rgb: [f64; 3]| illuminant_to_rgb(|l| basis_at(l, rgb));
+        for rgb in [
+            [1.0, 0.0, 0.0],
+            [0.2, 0.7, 0.1],
+            [-0.3, 1.2, -0.05],
+            [2.0, 2.0, 2.0],
+        ] {
+            let got = colour(rgb);
+            for c in 0..3 {
+                assert!((got[c] - rgb[c]).abs() < 1e-9, "{rgb:?} → {got:?}");
+            }
+        }
+        let wl = SampledWavelengths::sample_visible(0.37);
+        let basis = RgbIlluminantBasis::at(&wl);
+        let (a, b) = ([0.5, -0.2, 0.1], [-0.1, 0.6, 0.3]);
+        let sum = basis.spectrum(a) + basis.spectrum(b);
+        let of_sum = basis.spectrum([0.4, 0.4, 0.4]);
+        for i in 0..N_SAMPLES {
+            assert!((sum[i] - of_sum[i]).abs() < 1e-12);
+            let direct = basis_at(wl.lambda()[i], [0.4, 0.4, 0.4]);
+            assert!((of_sum[i] - direct).abs() < 1e-12);
+        }
+        let rgb = RgbIlluminantBasis::at(&SampledWavelengths::rgb()).spectrum(a);
+        assert_eq!(rgb.0, [0.5, -0.2, 0.1, 0.0]);
+    }
 
     fn close3(a: [f64; 3], b: [f64; 3], tol: f64) -> bool {
         (0..3).all(|i| (a[i] - b[i]).abs() <= tol * b[i].abs().max(1.0))
