@@ -11,6 +11,8 @@ pub mod environment;
 pub mod film;
 pub mod geometry;
 pub mod integrator;
+#[cfg(test)]
+mod kit;
 pub mod light;
 pub mod light_sampler;
 pub mod material;

@@ -918,3 +918,196 @@ fn record_subpath(
         parent = Some(t.push(node));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kit;
+    use crate::sampling::Rng;
+    use crate::settings::IntegratorKind;
+
+    const SIZE: u32 = 16;
+
+    fn tracer<'a>(
+        scene: &'a Scene,
+        camera: &'a Camera,
+        splats: &'a SplatBuffer,
+    ) -> BidirectionalPathTracer<'a> {
+        let config = IntegratorConfig {
+            kind: IntegratorKind::Bdpt,
+            max_depth: 4,
+            rr_depth: 100,
+            color: ColorMode::Rgb,
+            ..Default::default()
+        };
+        BidirectionalPathTracer::new(scene, &config, camera, splats, None)
+    }
+
+    /// Four camera and light subpaths per pixel, from seed 7.
+    fn subpaths(b: &BidirectionalPathTracer) -> Vec<(Vec<Vertex>, Vec<Vertex>)> {
+        let mut all = Vec::new();
+        for (x, y, i) in
+            (0..SIZE * SIZE * 4).map(|k| (k % SIZE, (k / SIZE) % SIZE, k / (SIZE * SIZE)))
+        {
+            let mut stream = SampleStream::random(Rng::for_sample(7, x, y, i));
+            let ray = b
+                .camera
+                .sample_ray(x as f64 + 0.5, y as f64 + 0.5, [0.5; 2], 0.0);
+            let mut wl = SampledWavelengths::rgb();
+            let mut counts = RayCounts::default();
+            let (mut camera, mut light) = (Vec::new(), Vec::new());
+            b.camera_subpath(&ray, 7, &mut wl, &mut stream, &mut counts, &mut camera);
+            b.light_subpath(ray.time, 6, &mut wl, &mut stream, &mut counts, &mut light);
+            all.push((camera, light));
+        }
+        all
+    }
+
+    /// Equal to 10⁻⁴: a walk's ray leaves from an offset origin, which at the lamp's 0.01
+    /// from the ceiling moves a density by 2·10⁻⁵. A wrong density is off by far more.
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= 1e-4 * a.abs().max(b.abs()) + 1e-12
+    }
+
+    /// The walks store at each vertex the area densities that the one-step density
+    /// (`pdf`, which the weights use) gives for its neighbours: forward from the previous
+    /// vertex, and in reverse from the next.
+    #[test]
+    fn subpaths_store_the_densities_of_their_steps() {
+        for glossy in [false, true] {
+            let scene = kit::cornell_box(glossy);
+            let camera = Camera::new(&scene.camera, SIZE, SIZE);
+            let splats = SplatBuffer::new(SIZE, SIZE, 1.0);
+            let b = tracer(&scene, &camera, &splats);
+            let mut checked = 0;
+            for (cam, light) in subpaths(&b) {
+                for path in [&cam, &light] {
+                    // Directions between nearly coincident points (a corner) are noise.
+                    let far = |a: usize, b: usize| (path[a].p - path[b].p).length() > 1e-3;
+                    for j in 1..path.len() {
+                        if path[j].infinite || !far(j - 1, j) || (j >= 2 && !far(j - 2, j - 1)) {
+                            continue;
+                        }
+                        let fwd = match j {
+                            1 if path[0].kind == Kind::Light => b.pdf_light(&path[0], &path[1]),
+                            1 => b.pdf(&path[0], None, &path[1]),
+                            _ => b.pdf(&path[j - 1], Some(&path[j - 2]), &path[j]),
+                        };
+                        assert!(
+                            close(path[j].pdf_fwd, fwd),
+                            "vertex {j} forward: stored {} ≠ {fwd}",
+                            path[j].pdf_fwd
+                        );
+                        if j + 2 < path.len()
+                            && !path[j + 2].infinite
+                            && far(j, j + 1)
+                            && far(j + 1, j + 2)
+                        {
+                            let rev = b.pdf(&path[j + 1], Some(&path[j + 2]), &path[j]);
+                            assert!(
+                                close(path[j].pdf_rev, rev),
+                                "vertex {j} reverse: stored {} ≠ {rev}",
+                                path[j].pdf_rev
+                            );
+                        }
+                        checked += 1;
+                    }
+                }
+                if let Some(origin) = light.first() {
+                    if light.len() > 1 {
+                        let pos = b.pdf_light_origin(origin, &light[1]);
+                        assert!(
+                            close(origin.pdf_fwd, pos),
+                            "light origin: {} ≠ {pos}",
+                            origin.pdf_fwd
+                        );
+                    }
+                }
+            }
+            assert!(checked > 1000, "{checked} vertices checked");
+        }
+    }
+
+    /// Veach's power heuristic, computed from its definition: a path x₀ (on the lamp) …
+    /// x_{n−1} (the lens) that strategy s samples with density
+    /// p_s = Π_{i<s} p→(x_i) · Π_{i≥s} p←(x_i) weighs p_s² / Σ_j p_j². The weights of all
+    /// strategies of the path then add up to 1. The paths are camera subpaths that reached
+    /// the lamp; each strategy gets the subpaths it would have sampled.
+    #[test]
+    fn every_strategy_of_a_path_weighs_as_the_power_heuristic() {
+        for glossy in [false, true] {
+            let scene = kit::cornell_box(glossy);
+            let camera = Camera::new(&scene.camera, SIZE, SIZE);
+            let splats = SplatBuffer::new(SIZE, SIZE, 1.0);
+            let b = tracer(&scene, &camera, &splats);
+            let mut paths = 0;
+            for (cam, _) in subpaths(&b) {
+                let Some(last) = cam.last() else { continue };
+                if cam.len() < 3 || last.kind != Kind::Surface || last.light.is_none() {
+                    continue;
+                }
+                // x₀ … x_{n−1}: the camera subpath reversed.
+                let x: Vec<Vertex> = cam.iter().rev().copied().collect();
+                let n = x.len();
+                let mut origin = Vertex::endpoint(Kind::Light, x[0].p, SampledSpectrum::ONE);
+                origin.light = x[0].light;
+                origin.n = x[0].n;
+                origin.ns = x[0].n;
+                // p→(x_i), from the light; p←(x_i), from the camera (the lens point's own
+                // density is every strategy's, and left out).
+                let mut fwd = vec![
+                    b.pdf_light_origin(&origin, &x[1]),
+                    b.pdf_light(&origin, &x[1]),
+                ];
+                for i in 2..n - 1 {
+                    fwd.push(b.pdf(&x[i - 1], Some(&x[i - 2]), &x[i]));
+                }
+                let mut rev = vec![0.0; n - 1];
+                rev[n - 2] = b.pdf(&x[n - 1], None, &x[n - 2]);
+                for i in (0..n - 2).rev() {
+                    rev[i] = b.pdf(&x[i + 1], Some(&x[i + 2]), &x[i]);
+                }
+                let density = |s: usize| -> f64 {
+                    fwd[..s].iter().product::<f64>() * rev[s..].iter().product::<f64>()
+                };
+                let squares: f64 = (0..n).map(|s| density(s).powi(2)).sum();
+                let mut total = 0.0;
+                for s in 0..n {
+                    let t = n - s;
+                    let mut light_path: Vec<Vertex> = x[..s].to_vec();
+                    if s > 0 {
+                        light_path[0] = origin;
+                    }
+                    // The reverse densities of the two vertices at each end of the
+                    // connection came from the subpath's own next vertex, not from the
+                    // other side: the weight must compute them anew, so here they are wrong.
+                    const STALE: f64 = 12345.0;
+                    for (i, v) in light_path.iter_mut().enumerate() {
+                        v.pdf_fwd = fwd[i];
+                        v.pdf_rev = if i + 2 >= s { STALE } else { rev[i] };
+                    }
+                    let mut camera_path: Vec<Vertex> = x[s..].iter().rev().copied().collect();
+                    for (j, v) in camera_path.iter_mut().enumerate().skip(1) {
+                        v.pdf_fwd = rev[n - 1 - j];
+                        v.pdf_rev = if j + 2 >= t { STALE } else { fwd[n - 1 - j] };
+                    }
+                    let sampled = match (s, t) {
+                        (1, _) => Some(light_path[0]),
+                        (_, 1) => Some(camera_path[0]),
+                        _ => None,
+                    };
+                    let w = b.mis_weight(&light_path, &camera_path, sampled.as_ref(), s, t);
+                    let expected = density(s).powi(2) / squares;
+                    assert!(
+                        (w - expected).abs() < 1e-9,
+                        "path of {n} vertices, strategy s = {s}: weight {w}, power heuristic {expected}"
+                    );
+                    total += w;
+                }
+                assert!((total - 1.0).abs() < 1e-9, "weights add up to {total}");
+                paths += 1;
+            }
+            assert!(paths > 20, "{paths} paths reached the lamp");
+        }
+    }
+}
