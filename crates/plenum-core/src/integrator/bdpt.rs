@@ -19,8 +19,8 @@
 //! correction (§5.3, [`super::light_tracing`]); emission that no light represents (the
 //! background, a Phong material's k_e) is found by s = 0 alone and so takes weight 1.
 
-use super::light_tracing::{adjoint_cosine_of, leave_light, rgb, start_light_path, LightStart};
-use super::{IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Strategy};
+use super::light_path::{adjoint_cosine_of, leave_light, start_light_path, LightStart};
+use super::{rgb, IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Strategy};
 use crate::accel::Coherence;
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;

@@ -9,6 +9,7 @@
 
 mod bdpt;
 mod direct;
+mod light_path;
 mod light_tracing;
 mod medium;
 mod path;
@@ -206,6 +207,12 @@ impl<'a> Integrator<'a> {
             _ => RayCounts::default(),
         }
     }
+}
+
+/// A sample's spectrum as linear sRGB.
+fn rgb(l: SampledSpectrum, wl: &SampledWavelengths) -> Color {
+    let [r, g, b] = l.to_linear_srgb(wl);
+    Color::new(r, g, b)
 }
 
 /// Applies `f` to node `node` of the ray tree, where a tree is being recorded.

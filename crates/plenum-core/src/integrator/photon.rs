@@ -35,11 +35,10 @@
 //! the caustic map's caustics; docs/photon-mapping.md gives the measured values.
 
 use super::direct::{self, sample_ld};
-use super::light_tracing::rgb;
 use super::photon_map::{Nearest, Photon, PhotonMap, Query};
 use super::photons::{emitted, escaped, shading_correction, PhotonTracer};
 use super::{
-    record, record_hit, FoundPhoton, IntegratorConfig, PhotonConfig, PhotonGather, RayCounts,
+    record, record_hit, rgb, FoundPhoton, IntegratorConfig, PhotonConfig, PhotonGather, RayCounts,
     RayKind, RayNode, RayTree,
 };
 use crate::bxdf::{Bsdf, TransportMode};

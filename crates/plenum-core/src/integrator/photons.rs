@@ -1,11 +1,10 @@
 //! What photon mapping (Jensen 1996) and stochastic progressive photon mapping (Hachisuka and
 //! Jensen 2009) share: photon paths traced from the lights, and the eye side's direct light.
 //!
-//! A photon path is the light tracer's path without the camera connections: a light chosen
-//! by power, a ray from its emission (pbrt-v4's `SampleLe`), scattering by the adjoint BSDF
-//! with Veach's shading-normal correction, Russian roulette on the throughput. Every arrival
-//! on a surface with a diffuse or glossy lobe is handed to the caller, which stores it (a
-//! photon map) or splats it onto the visible points near it (SPPM).
+//! A photon path is the light tracer's path without the camera connections
+//! ([`super::light_path`]): every arrival on a surface with a diffuse or glossy lobe is
+//! handed to the caller, which stores it (a photon map) or splats it onto the visible
+//! points near it (SPPM).
 //!
 //! Depth: a photon's `depth` counts its surface vertices from the light, 1 for the first
 //! hit. An eye vertex at depth e (1: the camera ray's hit) joined to a photon of depth d makes
@@ -13,50 +12,23 @@
 //! so the photon methods use a photon at an eye vertex only where d ≤ `max_depth` + 2 − e,
 //! and render the same paths as the path tracer.
 
-use super::light_tracing::{adjoint_cosine, leave_light, start_light_path};
-use super::{IntegratorConfig, RayCounts};
-use crate::bxdf::TransportMode;
-use crate::math::{offset_ray_origin, Ray, Vec3};
+pub(super) use super::light_path::Arrival;
+use super::light_path::LightPaths;
+use super::{IntegratorConfig, RayCounts, RayKind};
+use crate::math::Vec3;
 use crate::sampling::{Rng, SampleStream};
 use crate::scene::{Interaction, Scene};
 use plenum_spectrum::{SampledSpectrum, SampledWavelengths};
 
-/// A photon arriving at a surface that can scatter it diffusely or glossily.
-pub(super) struct Arrival<'a> {
-    pub it: &'a Interaction,
-    /// Unit direction back toward where the photon came from (the BSDF's ωi).
-    pub wi: Vec3,
-    /// The photon's flux weight: the emitted power over the sampling densities, not yet
-    /// divided by the number of photon paths.
-    pub beta: SampledSpectrum,
-    /// Surface vertices from the light, 1 for the first hit.
-    pub depth: u32,
-    /// Only specular bounces since the light (and at least one): a caustic photon, L S+ D.
-    pub caustic: bool,
-    /// The path may still make caustics further on: no diffuse or glossy bounce since the
-    /// light, and the surface has a specular lobe to leave by (Phong glass, a mirror with a
-    /// highlight).
-    pub may_continue_caustic: bool,
-}
-
-/// Traces photon paths through one scene.
+/// Traces photon paths through one scene: light paths whose rays count as photon rays.
 pub(super) struct PhotonTracer<'a> {
-    scene: &'a Scene,
-    max_depth: u32,
-    rr_depth: u32,
-    center: Vec3,
-    radius: f64,
+    paths: LightPaths<'a>,
 }
 
 impl<'a> PhotonTracer<'a> {
     pub fn new(scene: &'a Scene, config: &IntegratorConfig) -> Self {
-        let (center, radius) = scene.bounding_sphere();
         PhotonTracer {
-            scene,
-            max_depth: config.max_depth,
-            rr_depth: config.rr_depth,
-            center,
-            radius,
+            paths: LightPaths::new(scene, config),
         }
     }
 
@@ -82,60 +54,20 @@ impl<'a> PhotonTracer<'a> {
         counts: &mut RayCounts,
         mut arrive: impl FnMut(&Arrival, &SampledWavelengths) -> bool,
     ) {
-        let scene = self.scene;
-        let Some(start) = start_light_path(scene, (self.center, self.radius), wl, stream) else {
+        let Some(start) = self.paths.start(wl, stream) else {
             return;
         };
-        let mut beta = start.beta;
-        let mut ray = leave_light(&start.es).at_time(time);
-        let mut specular_only = true;
-        for depth in 1..=self.max_depth + 1 {
-            counts.photon += 1;
-            let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
-                break;
-            };
-            let it = scene.interaction(&ray, prim, &hit);
-            let wo = -ray.direction.normalized();
-            let Some(bsdf) = scene.bsdf(&it, wo, wl) else {
-                break;
-            };
-            let flags = bsdf.flags();
-            if flags.is_non_specular() {
-                let arrival = Arrival {
-                    it: &it,
-                    wi: wo,
-                    beta,
-                    depth,
-                    caustic: specular_only && depth > 1,
-                    may_continue_caustic: specular_only && flags.is_specular(),
-                };
-                if !arrive(&arrival, wl) {
-                    break;
-                }
-            }
-            if depth == self.max_depth + 1 {
-                break;
-            }
-            let uc = stream.next_1d();
-            let Some(bs) = bsdf.sample_f(wo, uc, stream.next_2d(), TransportMode::Importance)
-            else {
-                break;
-            };
-            beta *= bs.f * (adjoint_cosine(&it, wo, bs.wi) / bs.pdf);
-            specular_only &= bs.is_specular();
-            if beta.is_black() {
-                break;
-            }
-            let rr = beta.max_value();
-            if depth > self.rr_depth && rr < 1.0 {
-                let q = (1.0 - rr).max(0.0);
-                if stream.next_1d() < q {
-                    break;
-                }
-                beta /= 1.0 - q;
-            }
-            ray = Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(time);
-        }
+        let kind = RayKind::Photon;
+        self.paths.walk(
+            &start,
+            time,
+            wl,
+            stream,
+            counts,
+            kind,
+            None,
+            |a, wl, _, _| arrive(a, wl),
+        );
     }
 }
 

@@ -34,10 +34,9 @@
 //! [`crate::bxdf::Bsdf::diffuse_fraction`] and divided by its probability.
 
 use super::direct::{bsdf_pdf, bsdf_sample_ld, emitted_mis, infinite_mis, sample_ld, Lobes};
-use super::light_tracing::rgb;
 use super::photons::{Arrival, PhotonTracer};
 use super::{
-    record, record_hit, FoundPhoton, PhotonGather, RayCounts, RayKind, RayNode, RayTree, Stop,
+    record, record_hit, rgb, FoundPhoton, PhotonGather, RayCounts, RayKind, RayNode, RayTree, Stop,
     WholeImage,
 };
 use crate::bxdf::{Bsdf, TransportMode};
