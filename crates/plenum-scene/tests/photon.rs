@@ -488,13 +488,14 @@ normal = [0, 1, 0]
     assert_mean_within("photon", m, "the path tracer's", reference, 0.01);
 }
 
-/// Spectral photons add with their colours' signs. A green lamp's caustic through a glass
+/// Spectral photons keep the sign of their colours. A green lamp's caustic through a glass
 /// ball on a grey floor: every surface is grey, so the image has the lamp's colour, whose
 /// red is about −0.001 of its green (−0.0004 by BDPT at 256 spp, −0.0017 by integrating
 /// the uplifted (0, 1, 0) at 1 nm). A photon's flux seen at four wavelengths is a colour far
-/// outside the gamut (at 500 nm red is strongly negative); read back as a fitted spectrum,
-/// each photon lost its negative red, and red/green came out +0.0051 to +0.0067 (seeds 1–5).
-/// Read through a linear basis: −0.0009 to +0.0011 (seeds 1–6). Tolerance 0.0025 about 0.
+/// outside the gamut (at 500 nm red is strongly negative); read back as the spectrum fitted
+/// to its clamped colour, each photon lost its negative red, and red/green came out
+/// +0.0051 to +0.0067 (seeds 1–5). Positive part minus negative part: −0.0009 to +0.0009
+/// (seeds 1–6). Tolerance 0.0025 about 0.
 #[test]
 fn spectral_photons_keep_negative_channels() {
     let l = scene(

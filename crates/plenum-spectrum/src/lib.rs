@@ -27,5 +27,5 @@ pub use sampled::{
     sample_visible_wavelength, visible_pdf, ColorMode, SampledSpectrum, SampledWavelengths,
     N_SAMPLES,
 };
-pub use spectrum::{RgbIlluminantBasis, Spectrum};
+pub use spectrum::Spectrum;
 pub use uplift::{RgbSigmoid, RgbToSpectrumTable};

@@ -21,14 +21,14 @@
 //! The passes are deterministic: photon path i takes its random numbers from (seed, pass, i)
 //! and chunks of paths are traced in parallel and joined in order.
 //!
-//! Colour: a photon keeps its flux as linear sRGB, from its own wavelengths (a colour often
-//! outside the gamut: four wavelengths of a saturated spectrum); the eye pass, at other
-//! wavelengths, reads it through a linear basis of spectra ([`RgbIlluminantBasis`]), so that
-//! the photons of a density estimate add with their colours' signs, as their sum's colour
-//! would. (Fitting each photon a spectrum, as the scene's RGB lights are, would clamp their
-//! negative channels: saturated indirect light too bright however many photons.) In RGB
-//! mode this is exact; spectrally one bias remains, the difference between a spectral
-//! product and the product with a spectrum of the same colour.
+//! Colour: a photon keeps its flux as linear sRGB, from its own wavelengths: often a colour
+//! outside the gamut, with negative channels (four wavelengths of a saturated spectrum). The
+//! eye pass, at other wavelengths, reads it as the spectrum fitted to its positive channels
+//! minus the one fitted to its negative channels, so that it keeps its colour exactly and the
+//! photons of an estimate add with their signs; the fit alone would clamp the negative
+//! channels (saturated light too bright however many photons). In RGB mode this is exact;
+//! spectrally one bias remains, the difference between a spectral product and the product
+//! with a fitted spectrum of the same colour.
 //!
 //! Bias: density estimation blurs the global map's light over the k nearest photons (seen
 //! only after a gather bounce, so mostly where gather rays land close by: in corners) and
@@ -47,7 +47,7 @@ use crate::color::Color;
 use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::sampling::SampleStream;
 use crate::scene::{Interaction, Scene};
-use plenum_spectrum::{ColorMode, RgbIlluminantBasis, SampledSpectrum, SampledWavelengths};
+use plenum_spectrum::{ColorMode, SampledSpectrum, SampledWavelengths};
 use rayon::prelude::*;
 
 /// Photon paths traced per parallel chunk of a pass.
@@ -405,7 +405,6 @@ impl<'a> PhotonMapper<'a> {
         if r2 <= 0.0 {
             return (SampledSpectrum::ZERO, 0.0);
         }
-        let basis = RgbIlluminantBasis::at(wl);
         let mut sum = SampledSpectrum::ZERO;
         for &(_, i) in found {
             if Some(i) == skip {
@@ -418,7 +417,7 @@ impl<'a> PhotonMapper<'a> {
                 continue;
             }
             let power = Color::new(ph.power[0] as f64, ph.power[1] as f64, ph.power[2] as f64);
-            sum += f * basis.spectrum([power.r, power.g, power.b]) * shading_correction(it, wi);
+            sum += f * signed_radiance(self.scene, power, wl) * shading_correction(it, wi);
             if let Some(list) = found_photons.as_deref_mut() {
                 let position = Vec3::new(ph.p[0] as f64, ph.p[1] as f64, ph.p[2] as f64);
                 list.push(FoundPhoton {
@@ -446,6 +445,18 @@ impl PhotonConfig {
             0.1 * scene.scene_radius()
         }
     }
+}
+
+/// A photon's flux, linear sRGB of any sign, as a spectrum at `wl`: the fitted spectrum of
+/// its positive channels minus that of its negative ones, whose colour is the flux's own.
+fn signed_radiance(scene: &Scene, c: Color, wl: &SampledWavelengths) -> SampledSpectrum {
+    let positive = Color::new(c.r.max(0.0), c.g.max(0.0), c.b.max(0.0));
+    let negative = Color::new(positive.r - c.r, positive.g - c.g, positive.b - c.b);
+    let s = scene.rgb_radiance(positive, wl);
+    if negative == Color::BLACK {
+        return s;
+    }
+    s - scene.rgb_radiance(negative, wl)
 }
 
 fn f32s(v: Vec3) -> [f32; 3] {
