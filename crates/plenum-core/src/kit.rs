@@ -3,7 +3,7 @@
 
 use crate::camera::CameraSettings;
 use crate::color::Color;
-use crate::geometry::{Polygon, Shape};
+use crate::geometry::{Polygon, Shape, Sphere};
 use crate::light::Emitter;
 use crate::material::{
     ConductorMaterial, ConductorSpec, DiffuseMaterial, FloatTexture, Material, MaterialId,
@@ -125,6 +125,33 @@ pub fn cornell_box(glossy: bool) -> Scene {
             edge_v: v(0.0, 0.0, 0.6),
         },
         Color::gray(10.0),
+        1,
+    );
+    b.build()
+}
+
+/// A furnace: the camera (fov 90°) at the centre of a sphere of radius 1, diffuse of
+/// reflectance `albedo` and emitting `radiance` on both sides. Radiance is the same along
+/// every ray: L = L_e·Σ_{k≤D+1} ρ^k over paths of up to D + 1 scattering vertices
+/// (`max_depth` D), L_e/(1 − ρ) without a bound.
+pub fn furnace(albedo: f64, radiance: f64) -> Scene {
+    let mut b = SceneBuilder::default();
+    b.camera = CameraSettings {
+        position: Vec3::ZERO,
+        look_at: Vec3::new(0.0, 0.0, -1.0),
+        fov_degrees: 90.0,
+        ..CameraSettings::default()
+    };
+    let wall = b.add_material("wall", diffuse(Color::gray(albedo)));
+    let sphere = Shape::Sphere(Sphere::new(Vec3::ZERO, 1.0));
+    let radiance = Color::gray(radiance);
+    b.add_emissive_object(
+        "sphere",
+        sphere,
+        Transform::IDENTITY,
+        wall,
+        radiance,
+        true,
         1,
     );
     b.build()

@@ -237,3 +237,71 @@ fn record_hit(
         n.distance = Some(distance);
     });
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::film::Film;
+    use crate::kit;
+    use crate::sampling::Rng;
+
+    /// Every method counts emission and depth alike: in a furnace of reflectance ½ and
+    /// emission 1, `max_depth` D gives Σ_{k≤D+1} 2^−k (D + 1 scattering vertices, the
+    /// emitter met after the last; D = 0 is direct light, Mitsuba's `max_depth` 2).
+    /// Means over 8×8 pixels, seed 5, without Russian roulette; one bounce more or less is
+    /// 7 % or more at D ≤ 1. Path and BDPT, 16 spp: within 0.2 % (measured: 0 and 0.06 %);
+    /// light tracing, 64 spp: within 1 % (0.42 %); photon mapping, 20,000 photon paths and
+    /// k = 200 (a density estimate is exact for light spread evenly, as here), 4 spp: within
+    /// 1 % (0.18 %).
+    #[test]
+    fn every_method_counts_emission_and_depth_alike_in_a_furnace() {
+        const SIZE: u32 = 8;
+        let scene = kit::furnace(0.5, 1.0);
+        let camera = Camera::new(&scene.camera, SIZE, SIZE);
+        for depth in [0, 1, 3] {
+            let expected: f64 = (0..=depth + 1).map(|k| 0.5f64.powi(k as i32)).sum();
+            for (kind, spp, tolerance) in [
+                (IntegratorKind::Path, 16, 0.002),
+                (IntegratorKind::Bdpt, 16, 0.002),
+                (IntegratorKind::Light, 64, 0.01),
+                (IntegratorKind::Photon, 4, 0.01),
+            ] {
+                let config = IntegratorConfig {
+                    kind,
+                    max_depth: depth,
+                    rr_depth: 1000,
+                    color: ColorMode::Rgb,
+                    photon: PhotonConfig {
+                        photons: 20_000,
+                        caustic_photons: 0,
+                        nearest: 200,
+                        ..PhotonConfig::default()
+                    },
+                    ..IntegratorConfig::default()
+                };
+                let splats = SplatBuffer::new(SIZE, SIZE, 1.0 / spp as f64);
+                let integrator = Integrator::new(&scene, &config, &camera, &splats, None, 5);
+                let mut film = Film::new(SIZE, SIZE);
+                let mut counts = RayCounts::default();
+                for (x, y) in (0..SIZE * SIZE).map(|i| (i % SIZE, i / SIZE)) {
+                    for i in 0..spp {
+                        let mut stream = SampleStream::random(Rng::for_sample(5, x, y, i));
+                        let (dx, dy) = (stream.next_1d(), stream.next_1d());
+                        let ray = camera.sample_ray(x as f64 + dx, y as f64 + dy, [0.5; 2], 0.0);
+                        let c = integrator.camera_ray(&ray, &mut stream, &mut counts, None);
+                        film.add_sample(x, y, c, 1.0);
+                    }
+                }
+                film.add_splats(&splats);
+                film.resolve(1.0);
+                let pixels = film.pixels();
+                let mean = pixels.iter().map(|p| p[1] as f64).sum::<f64>() / pixels.len() as f64;
+                assert!(
+                    (mean / expected - 1.0).abs() < tolerance,
+                    "{}, max_depth {depth}: {mean:.4}, expected {expected:.4}",
+                    kind.name()
+                );
+            }
+        }
+    }
+}
