@@ -181,12 +181,12 @@ impl<'a> Integrator<'a> {
                 p.li(ray, &mut wl, stream, counts, tree)
             }
         };
-        let [r, g, b] = l.to_linear_srgb(&wl);
-        if !(r.is_finite() && g.is_finite() && b.is_finite()) {
+        let c = rgb(l, &wl);
+        if !(c.r.is_finite() && c.g.is_finite() && c.b.is_finite()) {
             counts.invalid += 1;
             return Color::BLACK;
         }
-        Color::new(r, g, b)
+        c
     }
 
     /// How the method represents light.
