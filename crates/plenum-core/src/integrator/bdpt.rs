@@ -928,19 +928,24 @@ mod tests {
 
     const SIZE: u32 = 16;
 
-    fn tracer<'a>(
-        scene: &'a Scene,
-        camera: &'a Camera,
-        splats: &'a SplatBuffer,
-    ) -> BidirectionalPathTracer<'a> {
-        let config = IntegratorConfig {
-            kind: IntegratorKind::Bdpt,
-            max_depth: 4,
-            rr_depth: 100,
-            color: ColorMode::Rgb,
-            ..Default::default()
-        };
-        BidirectionalPathTracer::new(scene, &config, camera, splats, None)
+    /// Runs `test` on BDPT (`max_depth` 4, no Russian roulette) in the kit's Cornell box,
+    /// diffuse and with a rough metal wall.
+    fn in_both_boxes(test: impl Fn(&BidirectionalPathTracer)) {
+        for glossy in [false, true] {
+            let scene = kit::cornell_box(glossy);
+            let camera = Camera::new(&scene.camera, SIZE, SIZE);
+            let splats = SplatBuffer::new(SIZE, SIZE, 1.0);
+            let config = IntegratorConfig {
+                kind: IntegratorKind::Bdpt,
+                max_depth: 4,
+                rr_depth: 100,
+                color: ColorMode::Rgb,
+                ..Default::default()
+            };
+            test(&BidirectionalPathTracer::new(
+                &scene, &config, &camera, &splats, None,
+            ));
+        }
     }
 
     /// Four camera and light subpaths per pixel, from seed 7.
@@ -974,13 +979,9 @@ mod tests {
     /// vertex, and in reverse from the next.
     #[test]
     fn subpaths_store_the_densities_of_their_steps() {
-        for glossy in [false, true] {
-            let scene = kit::cornell_box(glossy);
-            let camera = Camera::new(&scene.camera, SIZE, SIZE);
-            let splats = SplatBuffer::new(SIZE, SIZE, 1.0);
-            let b = tracer(&scene, &camera, &splats);
+        in_both_boxes(|b| {
             let mut checked = 0;
-            for (cam, light) in subpaths(&b) {
+            for (cam, light) in subpaths(b) {
                 for path in [&cam, &light] {
                     // Directions between nearly coincident points (a corner) are noise.
                     let far = |a: usize, b: usize| (path[a].p - path[b].p).length() > 1e-3;
@@ -1025,7 +1026,7 @@ mod tests {
                 }
             }
             assert!(checked > 1000, "{checked} vertices checked");
-        }
+        });
     }
 
     /// Veach's power heuristic, computed from its definition: a path x₀ (on the lamp) …
@@ -1035,13 +1036,9 @@ mod tests {
     /// the lamp; each strategy gets the subpaths it would have sampled.
     #[test]
     fn every_strategy_of_a_path_weighs_as_the_power_heuristic() {
-        for glossy in [false, true] {
-            let scene = kit::cornell_box(glossy);
-            let camera = Camera::new(&scene.camera, SIZE, SIZE);
-            let splats = SplatBuffer::new(SIZE, SIZE, 1.0);
-            let b = tracer(&scene, &camera, &splats);
+        in_both_boxes(|b| {
             let mut paths = 0;
-            for (cam, _) in subpaths(&b) {
+            for (cam, _) in subpaths(b) {
                 let Some(last) = cam.last() else { continue };
                 if cam.len() < 3 || last.kind != Kind::Surface || last.light.is_none() {
                     continue;
@@ -1108,6 +1105,6 @@ mod tests {
                 paths += 1;
             }
             assert!(paths > 20, "{paths} paths reached the lamp");
-        }
+        });
     }
 }
