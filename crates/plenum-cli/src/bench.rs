@@ -168,7 +168,7 @@ impl Target {
             Target::Mesh(m) => m
                 .intersect(ray, t_max)
                 .map(|h| (h.t, m.source_triangle(h.part))),
-            Target::Scene(s) => s.intersect(ray, t_max).map(|(p, h)| (h.t, p)),
+            Target::Scene(s) => s.geometry.intersect(ray, t_max).map(|(p, h)| (h.t, p)),
             #[cfg(feature = "embree")]
             Target::Embree(e) => e.closest(ray, t_max),
         }
@@ -177,7 +177,7 @@ impl Target {
     fn occluded(&self, ray: &Ray, t_max: f64, coherence: Coherence) -> bool {
         match self {
             Target::Mesh(m) => m.intersect_any_as(ray, t_max, coherence).is_some(),
-            Target::Scene(s) => s.occluded(ray, t_max, coherence),
+            Target::Scene(s) => s.geometry.occluded(ray, t_max, coherence),
             #[cfg(feature = "embree")]
             Target::Embree(e) => e.occluded(ray, t_max, coherence),
         }
@@ -186,7 +186,7 @@ impl Target {
     fn primitive_count(&self) -> usize {
         match self {
             Target::Mesh(m) => m.triangle_count(),
-            Target::Scene(s) => s.primitives.len(),
+            Target::Scene(s) => s.geometry.primitives.len(),
             #[cfg(feature = "embree")]
             Target::Embree(e) => e.triangle_count(),
         }
@@ -203,7 +203,7 @@ impl Target {
     fn memory_bytes(&self) -> usize {
         match self {
             Target::Mesh(m) => m.memory_bytes(),
-            Target::Scene(s) => s.accel_memory_bytes(),
+            Target::Scene(s) => s.geometry.accel_memory_bytes(),
             // Embree does not say.
             #[cfg(feature = "embree")]
             Target::Embree(_) => 0,

@@ -582,7 +582,7 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
     let light_sampler = view.light_sampler.map_or(d.light_sampler, |a| a.0);
     loaded.scene.set_light_sampler(light_sampler);
     if !method.is_classic() && color == ColorMode::Rgb {
-        if let Some(what) = loaded.scene.needs_wavelengths() {
+        if let Some(what) = loaded.scene.materials.needs_wavelengths() {
             eprintln!("warning: {what} needs wavelengths: in RGB mode it is rendered at 589.3 nm (use --color spectral)");
         }
     }
@@ -839,7 +839,7 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
             defaults,
             warnings,
         };
-        for what in loaded.scene.capped_structures() {
+        for what in loaded.scene.geometry.capped_structures() {
             eprintln!(
                 "warning: the {} over {what} reached its memory bound (items that overlap many cells); it is kept coarser there, and slower",
                 args.accel

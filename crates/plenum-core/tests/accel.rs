@@ -236,13 +236,22 @@ fn check_scene(
     }
     for kind in FAST {
         let scene = scene_of(spheres, polygons, kind);
-        prop_assert_eq!(scene.accel_kind(), kind);
+        prop_assert_eq!(scene.geometry.accel_kind(), kind);
         for ray in &all {
-            let want = oracle.intersect(ray, f64::INFINITY).map(|(p, h)| (p, h.t));
-            let got = scene.intersect(ray, f64::INFINITY).map(|(p, h)| (p, h.t));
+            let want = oracle
+                .geometry
+                .intersect(ray, f64::INFINITY)
+                .map(|(p, h)| (p, h.t));
+            let got = scene
+                .geometry
+                .intersect(ray, f64::INFINITY)
+                .map(|(p, h)| (p, h.t));
             agree(got, want).map_err(|e| TestCaseError::fail(format!("{kind}: {e}")))?;
             for coherence in [Coherence::Incoherent, Coherence::Coherent] {
-                prop_assert_eq!(scene.occluded(ray, f64::INFINITY, coherence), got.is_some());
+                prop_assert_eq!(
+                    scene.geometry.occluded(ray, f64::INFINITY, coherence),
+                    got.is_some()
+                );
             }
         }
     }
@@ -286,9 +295,14 @@ fn empty_scene_misses() {
     for kind in AccelKind::ALL {
         let scene = scene_of(&[], &[], kind);
         let ray = Ray::new(Vec3::ZERO, Vec3::new(0.3, -0.2, 1.0));
-        assert!(scene.intersect(&ray, f64::INFINITY).is_none(), "{kind}");
         assert!(
-            !scene.occluded(&ray, f64::INFINITY, Coherence::Incoherent),
+            scene.geometry.intersect(&ray, f64::INFINITY).is_none(),
+            "{kind}"
+        );
+        assert!(
+            !scene
+                .geometry
+                .occluded(&ray, f64::INFINITY, Coherence::Incoherent),
             "{kind}"
         );
     }

@@ -436,8 +436,8 @@ mod tests {
         assert_eq!(scene.background, Color::new(0.1, 0.2, 0.3));
         // Two point lights, and the background as the physically based methods' light.
         assert_eq!(scene.lights.len(), 3);
-        assert_eq!(scene.background_light, Some(2));
-        assert_eq!(scene.primitives.len(), 4);
+        assert_eq!(scene.lights.background, Some(2));
+        assert_eq!(scene.geometry.primitives.len(), 4);
         let level = 2f64.sqrt() / 4.0;
         assert!((scene.ambient.r - level).abs() < 1e-15);
         match &scene.lights[1] {

@@ -1205,7 +1205,7 @@ mod tests {
     fn transforms_nest_outside_in_with_radians() {
         let text = "SBT-raytracer 1.0\ntranslate(10, 0, 0, rotate(0, 0, 1, 1.5707963267948966, scale(2, 1, 1, sphere { })))\n";
         let (scene, _, _) = read(text).unwrap();
-        let b = scene.bounds();
+        let b = scene.geometry.bounds();
         // Scaled along x to 2, turned onto y, then moved: x in [9, 11], y in [-2, 2].
         assert!(
             (b.min.x - 9.0).abs() < 1e-9 && (b.max.y - 2.0).abs() < 1e-9,
@@ -1213,7 +1213,7 @@ mod tests {
         );
         let m = "SBT-raytracer 1.0\ntransform((1,0,0,5),(0,1,0,0),(0,0,1,0),(0,0,0,1), box { });\n";
         let (scene, _, _) = read(m).unwrap();
-        assert!((scene.bounds().min.x - 4.5).abs() < 1e-12);
+        assert!((scene.geometry.bounds().min.x - 4.5).abs() < 1e-12);
     }
 
     #[test]
@@ -1225,7 +1225,7 @@ mod tests {
         assert!((view - -Vec3::X).length() < 1e-9, "{view:?}");
         assert_eq!(warnings.len(), 1);
         assert!(warnings[0].contains("unknown field `focus`"));
-        match &scene.primitives[0].shape {
+        match &scene.geometry.primitives[0].shape {
             Shape::Mesh(m) => assert_eq!(m.triangle_count(), 2),
             _ => panic!(),
         }
@@ -1256,6 +1256,6 @@ mod tests {
             ")".repeat(MAX_NESTING - 1)
         );
         let (scene, _, _) = read(&text).unwrap();
-        assert_eq!(scene.primitives.len(), 1);
+        assert_eq!(scene.geometry.primitives.len(), 1);
     }
 }

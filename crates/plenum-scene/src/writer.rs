@@ -109,19 +109,19 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
     let _ = writeln!(w);
     // Objects that show an area light are written with their light.
     let mut shows_light: HashMap<u32, usize> = HashMap::new();
-    for (i, o) in scene.light_objects.iter().enumerate() {
+    for (i, o) in scene.lights.objects.iter().enumerate() {
         if let Some(o) = o {
             shows_light.insert(*o, i);
         }
     }
-    let keys = unique_keys(&scene.material_names, "material");
+    let keys = unique_keys(&scene.materials.names, "material");
     for (i, (key, m)) in keys.iter().zip(&scene.materials).enumerate() {
         let _ = writeln!(w, "[materials.{}]", quote(key));
         let m = match m {
             Material::Phong(m) => m,
             other => {
                 let _ = writeln!(w, "{}", physical_material(other, &keys));
-                if scene.is_one_sided(i as u32) {
+                if scene.materials.is_one_sided(i as u32) {
                     let _ = writeln!(w, "two_sided = false\n");
                 }
                 continue;
@@ -149,7 +149,7 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
     }
     // Meshes used more than once are written once.
     let mut uses: HashMap<*const (), usize> = HashMap::new();
-    for p in &scene.primitives {
+    for p in &scene.geometry.primitives {
         if let Shape::Mesh(m) = &p.shape {
             *uses
                 .entry(std::sync::Arc::as_ptr(m) as *const ())
@@ -157,7 +157,7 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
         }
     }
     let mut mesh_names: HashMap<*const (), String> = HashMap::new();
-    for p in &scene.primitives {
+    for p in &scene.geometry.primitives {
         if let Shape::Mesh(m) = &p.shape {
             let ptr = std::sync::Arc::as_ptr(m) as *const ();
             if uses[&ptr] > 1 && !mesh_names.contains_key(&ptr) {
@@ -174,9 +174,9 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
             color(scene.ambient)
         );
     }
-    for (i, (light, name)) in scene.lights.iter().zip(&scene.light_names).enumerate() {
+    for (i, (light, name)) in scene.lights.iter().zip(&scene.lights.names).enumerate() {
         // The background is written as `background`, not as a light.
-        if Some(i as u32) == scene.background_light {
+        if Some(i as u32) == scene.lights.background {
             continue;
         }
         if written_with_object(scene, i) {
@@ -297,7 +297,13 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
             }
         }
     }
-    for (index, (p, name)) in scene.primitives.iter().zip(&scene.object_names).enumerate() {
+    for (index, (p, name)) in scene
+        .geometry
+        .primitives
+        .iter()
+        .zip(&scene.geometry.names)
+        .enumerate()
+    {
         let light = shows_light.get(&(index as u32)).copied();
         let _ = match light.map(|i| (i, &scene.lights[i])) {
             Some((
@@ -390,12 +396,15 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
 /// with a material of its own; the lights of docs/scene-format.md's rectangle, disk and sphere
 /// kind are written as lights.
 fn written_with_object(scene: &Scene, light: usize) -> bool {
-    let Some(prim) = scene.light_objects[light] else {
+    let Some(prim) = scene.lights.objects[light] else {
         return false;
     };
-    let emitter_only =
-        scene.materials[scene.primitives[prim as usize].material as usize].is_emitter_only();
-    let mesh = matches!(scene.primitives[prim as usize].shape, Shape::Mesh(_));
+    let emitter_only = scene.materials[scene.geometry.primitives[prim as usize].material as usize]
+        .is_emitter_only();
+    let mesh = matches!(
+        scene.geometry.primitives[prim as usize].shape,
+        Shape::Mesh(_)
+    );
     mesh || !emitter_only
 }
 
@@ -512,7 +521,7 @@ fn spectrum(s: &Spectrum) -> String {
 
 /// A light's `color`, or its `spectrum` when it was given one.
 fn emission(scene: &Scene, light: usize, rgb: Color, key: &str) -> String {
-    let s = scene.light_emission(light as u32).spectrum();
+    let s = scene.lights.emission(light as u32).spectrum();
     if plenum_core::material::source_rgb(s).is_some() {
         format!("{key} = {}", color(rgb))
     } else {

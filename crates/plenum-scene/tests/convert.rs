@@ -50,8 +50,8 @@ fn round_trip(original: LoadedScene, what: &str) {
     };
     assert_eq!(back.defaults, expected, "{what}");
     assert_eq!(
-        back.scene.primitives.len(),
-        original.scene.primitives.len(),
+        back.scene.geometry.primitives.len(),
+        original.scene.geometry.primitives.len(),
         "{what}"
     );
     let (a, b) = (pixels(&original), pixels(&back));

@@ -337,7 +337,7 @@ fn every_structure_bounds_moving_objects() {
     let mut moving = loaded.scene.clone();
     moving.camera.shutter = [0.9, 0.9];
     let mut posed = moving.clone();
-    for p in &mut posed.primitives {
+    for p in &mut posed.geometry.primitives {
         if let Some(m) = p.motion.take() {
             p.to_world = Some(Box::new(m.at(0.9)));
         }

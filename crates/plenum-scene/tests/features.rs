@@ -112,6 +112,7 @@ transform = [{ rotate = { axis = [0, 0, 1], degrees = 90 } }, { scale = 3 }]
     let loaded = load_scene(&dir.join("scene.toml")).unwrap_or_else(|e| panic!("{e}"));
     let meshes: Vec<_> = loaded
         .scene
+        .geometry
         .primitives
         .iter()
         .map(|p| match &p.shape {
@@ -123,7 +124,7 @@ transform = [{ rotate = { axis = [0, 0, 1], degrees = 90 } }, { scale = 3 }]
     assert!(std::sync::Arc::ptr_eq(&meshes[0], &meshes[1]));
     assert!(std::sync::Arc::ptr_eq(&meshes[0], &meshes[2]));
     // Bounds: the third copy is rotated 90° and scaled by 3.
-    let b = loaded.scene.bounds();
+    let b = loaded.scene.geometry.bounds();
     assert!(
         (b.min.x + 3.0).abs() < 1e-9 && (b.max.x - 3.0).abs() < 1e-9,
         "{b:?}"

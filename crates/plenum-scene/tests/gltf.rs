@@ -98,7 +98,7 @@ fn nodes_place_one_mesh_many_times() {
     assert_eq!(objects.len(), 2);
     // Instanced: one mesh table, referenced twice.
     assert_eq!(t["meshes"].as_table().unwrap().len(), 1, "{t}");
-    let b = l.scene.bounds();
+    let b = l.scene.geometry.bounds();
     assert!(
         (b.min.x + 3.0).abs() < 1e-6 && (b.max.x - 2.5).abs() < 1e-6,
         "{b:?}"

@@ -17,6 +17,7 @@ fn meshes() -> PathBuf {
 fn counts(loaded: &LoadedScene) -> (usize, usize) {
     loaded
         .scene
+        .geometry
         .primitives
         .iter()
         .fold((0, 0), |(v, t), p| match &p.shape {

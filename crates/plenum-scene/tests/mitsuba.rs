@@ -179,7 +179,7 @@ fn transforms_compose_in_the_order_written() {
             <translate x="1"/><scale value="2"/>
         </transform></shape>"#,
     ));
-    let b = l.scene.bounds();
+    let b = l.scene.geometry.bounds();
     assert!(
         (b.max.x - 4.0).abs() < 1e-12 && (b.max.y - 2.0).abs() < 1e-12,
         "{b:?}"
@@ -193,7 +193,7 @@ fn transforms_compose_in_the_order_written() {
         r#"<shape type="sphere"><point name="center" x="1" y="0" z="0"/><float name="radius" value="0.1"/>
             <transform name="to_world"><rotate z="1" angle="90"/></transform></shape>"#,
     ));
-    let b = l.scene.bounds();
+    let b = l.scene.geometry.bounds();
     let c = (b.min + b.max) * 0.5;
     assert!(c.x.abs() < 1e-9 && (c.y - 1.0).abs() < 1e-9, "{c:?}");
 }

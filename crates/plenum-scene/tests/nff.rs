@@ -42,10 +42,16 @@ fn every_spd_file_loads_with_its_counts_and_renders() {
     for (file, lights, spheres, cones, polygons, patches, surfaces) in FILES {
         let loaded = load_scene(&shared(file)).unwrap_or_else(|e| panic!("{e}"));
         let scene = &loaded.scene;
-        let count =
-            |f: fn(&Shape) -> usize| scene.primitives.iter().map(|p| f(&p.shape)).sum::<usize>();
+        let count = |f: fn(&Shape) -> usize| {
+            scene
+                .geometry
+                .primitives
+                .iter()
+                .map(|p| f(&p.shape))
+                .sum::<usize>()
+        };
         // The file's lights; the background is one more, for the physically based methods.
-        let given = scene.lights.len() - usize::from(scene.background_light.is_some());
+        let given = scene.lights.len() - usize::from(scene.lights.background.is_some());
         assert_eq!(given, lights, "{file}: lights");
         assert_eq!(
             count(|s| matches!(s, Shape::Sphere(_)) as usize),
@@ -71,7 +77,7 @@ fn every_spd_file_loads_with_its_counts_and_renders() {
             "{file}: patches (all triangles in the SPD)"
         );
         assert_eq!(scene.materials.len(), surfaces, "{file}: surfaces");
-        let b = scene.bounds();
+        let b = scene.geometry.bounds();
         assert!(
             !b.is_empty() && b.min.is_finite() && b.max.is_finite(),
             "{file}: bounds {b:?}"
@@ -158,7 +164,7 @@ fn every_accelerator_renders_the_same_image() {
                     .unwrap_or_else(|e| panic!("{e}"))
                     .scene
                     .with_accel(kind);
-                assert_eq!(scene.accel_kind(), kind);
+                assert_eq!(scene.geometry.accel_kind(), kind);
                 render(&scene, &settings, &AtomicBool::new(false), &|_, _| {})
                     .film
                     .pixels()

@@ -123,7 +123,7 @@ Shape "disk" "float radius" 0.25
     assert_eq!(row(0), [2.0, 0.0, 0.0, 1.0]);
     // The second is back at the origin; the disk is 10 along z, from the saved system.
     assert!(objects[1].get("transform").is_none(), "{:?}", objects[1]);
-    let b = l.scene.bounds();
+    let b = l.scene.geometry.bounds();
     assert!(
         (b.max.z - 10.0).abs() < 1e-9 && (b.min.x + 1.0).abs() < 1e-9,
         "{b:?}"
@@ -181,7 +181,7 @@ Include "more.pbrt"
     assert_eq!(material(5)["type"].as_str(), Some("dielectric"));
     assert!((number(&material(5)["eta"]) - 1.33).abs() < 1e-12);
     // The included sphere is placed where the transformation stands: z = 10, radius 3.
-    let b = l.scene.bounds();
+    let b = l.scene.geometry.bounds();
     assert!(
         (b.max.z - 13.0).abs() < 1e-9 && (b.min.z + 1.0).abs() < 1e-9,
         "{b:?}"

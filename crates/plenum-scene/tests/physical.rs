@@ -75,9 +75,10 @@ faces = [[0, 2, 1], [3, 4, 5], [0, 1, 4, 3], [1, 2, 5, 4], [2, 0, 3, 5]]
         let mut ray = Ray::new(Vec3::new(-0.5, 0.2886751345948129, 0.0) - d0 * 2.0, d0);
         for interface in 0..2 {
             let (prim, hit) = s
+                .geometry
                 .intersect(&ray, f64::INFINITY)
                 .expect("the beam meets the prism");
-            let it = s.interaction(&ray, prim, &hit);
+            let it = s.geometry.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
             let bsdf = s.bsdf(&it, wo, &mut wl).expect("glass scatters");
             // u close to 1 chooses transmission (reflection takes u < R/(R+T)).
@@ -458,10 +459,11 @@ transform = [{ translate = [-4, 0, 0] }]
             let (p, n) = shape.sample_area(u).unwrap();
             let ray = Ray::new(p + n * 0.01, -n);
             let (prim, hit) = s
+                .geometry
                 .intersect(&ray, 0.02)
                 .unwrap_or_else(|| panic!("light {i}: sampled point {p:?} is not on the surface"));
-            assert_eq!(s.light_of(prim), Some(i as u32), "light {i}");
-            let it = s.interaction(&ray, prim, &hit);
+            assert_eq!(s.lights.of_primitive(prim), Some(i as u32), "light {i}");
+            let it = s.geometry.interaction(&ray, prim, &hit);
             assert!(
                 it.n.dot(n) > 0.999,
                 "light {i}: sampled normal {n:?}, hit normal {:?}",

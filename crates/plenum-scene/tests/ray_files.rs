@@ -69,14 +69,14 @@ fn every_course_file_loads_and_renders() {
         let loaded = load_scene(file).unwrap_or_else(|e| panic!("{e}"));
         let scene = &loaded.scene;
         let text = std::fs::read_to_string(file).unwrap();
-        let objects: HashSet<&String> = scene.object_names.iter().collect();
+        let objects: HashSet<&String> = scene.geometry.names.iter().collect();
         assert_eq!(
             objects.len(),
             primitives_written(&text),
             "{}",
             file.display()
         );
-        let b = scene.bounds();
+        let b = scene.geometry.bounds();
         assert!(
             !b.is_empty() && b.min.is_finite() && b.max.is_finite(),
             "{}: {b:?}",

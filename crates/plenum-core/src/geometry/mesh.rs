@@ -222,6 +222,11 @@ impl TriangleMesh {
         self.accel.capped()
     }
 
+    /// Which structure holds its triangles.
+    pub fn accel_kind(&self) -> AccelKind {
+        self.accel.kind()
+    }
+
     /// The mesh with its triangles in a `kind` structure instead.
     pub fn with_accel(&self, kind: AccelKind) -> TriangleMesh {
         self.rebuilt(kind, EMBED_LIMIT)

@@ -26,6 +26,7 @@ use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::SplatBuffer;
+use crate::material::rgb_radiance;
 use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::sampling::SampleStream;
 use crate::scene::Scene;
@@ -223,7 +224,7 @@ impl<'a> BidirectionalPathTracer<'a> {
         splats: &'a SplatBuffer,
         strategies: Option<&'a StrategyImages>,
     ) -> Self {
-        let (center, radius) = scene.bounding_sphere();
+        let (center, radius) = scene.geometry.bounding_sphere();
         BidirectionalPathTracer {
             scene,
             camera,
@@ -458,7 +459,7 @@ impl<'a> BidirectionalPathTracer<'a> {
         let mut eta_scale = 1.0;
         let mut added = 0;
         while added < max_vertices {
-            let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
+            let Some((prim, hit)) = scene.geometry.intersect(&ray, f64::INFINITY) else {
                 // A camera path that leaves the scene ends on the lights at infinity.
                 if mode == TransportMode::Radiance {
                     let mut v = Vertex::endpoint(Kind::Light, ray.origin, beta);
@@ -469,7 +470,7 @@ impl<'a> BidirectionalPathTracer<'a> {
                 }
                 return;
             };
-            let it = scene.interaction(&ray, prim, &hit);
+            let it = scene.geometry.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
             let bsdf = scene.bsdf(&it, wo, wl);
             let prev = *path.last().expect("a walk starts from an endpoint");
@@ -481,7 +482,7 @@ impl<'a> BidirectionalPathTracer<'a> {
                 ns: it.shading_n,
                 wo,
                 bsdf,
-                light: scene.light_of(prim),
+                light: scene.lights.of_primitive(prim),
                 infinite: false,
                 toward_light: Vec3::ZERO,
                 beta,
@@ -608,15 +609,15 @@ impl<'a> BidirectionalPathTracer<'a> {
             }
             let ul = stream.next_1d();
             let u = stream.next_2d();
-            let (index, pmf) = scene.light_sampler.sample(ul)?;
+            let (index, pmf) = scene.lights.sampler.sample(ul)?;
             let light = &scene.lights[index as usize];
             let ls = light.sample_li(pt.p, u)?;
             if ls.scale == 0.0 || ls.pdf == 0.0 {
                 return None;
             }
             let le = match ls.radiance {
-                Some(c) => scene.rgb_radiance(c, wl),
-                None => scene.light_spectrum(index, wl) * ls.scale,
+                Some(c) => rgb_radiance(c, wl),
+                None => scene.lights.spectrum(index, wl) * ls.scale,
             };
             let mut lv = Vertex::endpoint(
                 Kind::Light,
@@ -643,7 +644,10 @@ impl<'a> BidirectionalPathTracer<'a> {
                 Some(q) => (Ray::new(origin, q - origin), ls.shadow_end),
                 None => (Ray::new(origin, ls.wi), f64::INFINITY),
             };
-            if scene.occluded(&shadow.at_time(time), t_max, Coherence::Incoherent) {
+            if scene
+                .geometry
+                .occluded(&shadow.at_time(time), t_max, Coherence::Incoherent)
+            {
                 return None;
             }
             sampled = Some(lv);
@@ -690,7 +694,10 @@ impl<'a> BidirectionalPathTracer<'a> {
         let from = lift(a, b.p);
         let to = lift(b, a.p);
         let ray = Ray::new(from, to - from).at_time(time);
-        !self.scene.occluded(&ray, 1.0 - 1e-9, Coherence::Incoherent)
+        !self
+            .scene
+            .geometry
+            .occluded(&ray, 1.0 - 1e-9, Coherence::Incoherent)
     }
 
     fn connectible(&self, v: &Vertex) -> bool {
@@ -716,8 +723,8 @@ impl<'a> BidirectionalPathTracer<'a> {
         let scene = self.scene;
         if v.infinite {
             let mut l = SampledSpectrum::ZERO;
-            for &i in &scene.infinite_lights {
-                l += scene.radiance_from_infinity(i, v.toward_light, wl);
+            for &i in &scene.lights.infinite {
+                l += scene.lights.radiance_from_infinity(i, v.toward_light, wl);
             }
             return l;
         }
@@ -726,7 +733,7 @@ impl<'a> BidirectionalPathTracer<'a> {
         };
         let w = v.toward(toward);
         if scene.lights[i as usize].emits_toward(v.n, w) {
-            scene.light_spectrum(i, wl)
+            scene.lights.spectrum(i, wl)
         } else {
             SampledSpectrum::ZERO
         }
@@ -737,10 +744,11 @@ impl<'a> BidirectionalPathTracer<'a> {
     fn infinite_light_density(&self, toward_light: Vec3) -> f64 {
         let scene = self.scene;
         scene
-            .infinite_lights
+            .lights
+            .infinite
             .iter()
             .map(|&i| {
-                scene.light_sampler.pmf(i) * scene.lights[i as usize].pdf_direction(toward_light)
+                scene.lights.sampler.pmf(i) * scene.lights[i as usize].pdf_direction(toward_light)
             })
             .sum()
     }
@@ -755,7 +763,7 @@ impl<'a> BidirectionalPathTracer<'a> {
         };
         let w = v.toward(next);
         let e = self.scene.lights[i as usize].pdf_le(v.n, w, self.radius);
-        self.scene.light_sampler.pmf(i) * e.pos
+        self.scene.lights.sampler.pmf(i) * e.pos
     }
 
     /// The area density at `next` of light leaving the light vertex `v` toward it.

@@ -13,6 +13,7 @@ use super::RayCounts;
 use crate::accel::Coherence;
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::light::LightSample;
+use crate::material::rgb_radiance;
 use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::sampling::{power_heuristic, SampleStream};
 use crate::scene::{Interaction, Scene};
@@ -34,7 +35,7 @@ pub(super) fn sample_ld(
 ) -> SampledSpectrum {
     let ul = stream.next_1d();
     let u = stream.next_2d();
-    let Some((index, pmf)) = scene.light_sampler.sample(ul) else {
+    let Some((index, pmf)) = scene.lights.sampler.sample(ul) else {
         return SampledSpectrum::ZERO;
     };
     let light = &scene.lights[index as usize];
@@ -53,8 +54,8 @@ pub(super) fn sample_ld(
         return SampledSpectrum::ZERO;
     }
     let le = match ls.radiance {
-        Some(c) => scene.rgb_radiance(c, wl),
-        None => scene.light_spectrum(index, wl) * ls.scale,
+        Some(c) => rgb_radiance(c, wl),
+        None => scene.lights.spectrum(index, wl) * ls.scale,
     };
     let pdf_light = pmf * ls.pdf;
     if ls.delta || bsdf_samples == 0.0 {
@@ -73,7 +74,9 @@ fn occluded(scene: &Scene, it: &Interaction, ls: &LightSample, time: f64) -> boo
         Some(q) => (Ray::new(origin, q - origin), ls.shadow_end),
         None => (Ray::new(origin, ls.wi), f64::INFINITY),
     };
-    scene.occluded(&shadow.at_time(time), t_max, Coherence::Incoherent)
+    scene
+        .geometry
+        .occluded(&shadow.at_time(time), t_max, Coherence::Incoherent)
 }
 
 /// A BSDF-sampled ray's part of direct light: the radiance of area light `light`, hit at
@@ -95,8 +98,8 @@ pub(super) fn emitted_mis(
     if !l.emits_toward(it.n, wo) {
         return SampledSpectrum::ZERO;
     }
-    let pdf_light = scene.light_sampler.pmf(light) * l.pdf_li(from, it.p, it.n);
-    scene.light_spectrum(light, wl) * power_heuristic(bsdf_samples * pdf_bsdf, pdf_light)
+    let pdf_light = scene.lights.sampler.pmf(light) * l.pdf_li(from, it.p, it.n);
+    scene.lights.spectrum(light, wl) * power_heuristic(bsdf_samples * pdf_bsdf, pdf_light)
 }
 
 /// A BSDF-sampled ray's part of the light from infinity along `d`: the infinite lights,
@@ -109,9 +112,9 @@ pub(super) fn infinite_mis(
     bsdf_samples: f64,
 ) -> SampledSpectrum {
     let mut le = SampledSpectrum::ZERO;
-    for &i in &scene.infinite_lights {
-        let pdf_light = scene.light_sampler.pmf(i) * scene.lights[i as usize].pdf_direction(d);
-        le += scene.radiance_from_infinity(i, d, wl)
+    for &i in &scene.lights.infinite {
+        let pdf_light = scene.lights.sampler.pmf(i) * scene.lights[i as usize].pdf_direction(d);
+        le += scene.lights.radiance_from_infinity(i, d, wl)
             * power_heuristic(bsdf_samples * pdf_bsdf, pdf_light);
     }
     le
@@ -184,13 +187,13 @@ pub(super) fn bsdf_sample_ld(
         false => bsdf_pdf(bsdf, wo, &bs),
     };
     let ray = Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(time);
-    let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
+    let Some((prim, hit)) = scene.geometry.intersect(&ray, f64::INFINITY) else {
         let d = bs.wi.normalized();
         return beta * infinite_mis(scene, d, wl, pdf_bsdf, 1.0);
     };
-    match scene.light_of(prim) {
+    match scene.lights.of_primitive(prim) {
         Some(light) => {
-            let hit_it = scene.interaction(&ray, prim, &hit);
+            let hit_it = scene.geometry.interaction(&ray, prim, &hit);
             beta * emitted_mis(scene, light, &hit_it, -bs.wi, wl, pdf_bsdf, it.p, 1.0)
         }
         // Only a surface with k_e gives light: the others need no interaction.
@@ -199,7 +202,7 @@ pub(super) fn bsdf_sample_ld(
             .phong()
             .is_some_and(|m| !m.emissive.is_black()) =>
         {
-            let hit_it = scene.interaction(&ray, prim, &hit);
+            let hit_it = scene.geometry.interaction(&ray, prim, &hit);
             scene
                 .phong_emission(&hit_it, wl)
                 .map_or(SampledSpectrum::ZERO, |ke| beta * ke)

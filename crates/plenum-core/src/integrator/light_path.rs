@@ -10,6 +10,7 @@
 use super::{RayCounts, RayKind, RayNode, RayTree};
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::light::EmissionSample;
+use crate::material::rgb_radiance;
 use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::sampling::SampleStream;
 use crate::scene::{Interaction, Scene};
@@ -37,7 +38,7 @@ pub(super) fn start_light_path(
 ) -> Option<LightStart> {
     let ul = stream.next_1d();
     let (u_pos, u_dir) = (stream.next_2d(), stream.next_2d());
-    let (index, pmf) = scene.light_sampler.sample(ul)?;
+    let (index, pmf) = scene.lights.sampler.sample(ul)?;
     let es = scene.lights[index as usize].sample_le(u_pos, u_dir, center, radius)?;
     let le = emitted_spectrum(scene, index, &es, wl);
     if le.is_black() || es.pdf.pos == 0.0 || es.pdf.dir == 0.0 {
@@ -63,8 +64,8 @@ fn emitted_spectrum(
     wl: &SampledWavelengths,
 ) -> SampledSpectrum {
     match es.radiance {
-        Some(c) => scene.rgb_radiance(c, wl),
-        None => scene.light_spectrum(light, wl) * es.scale,
+        Some(c) => rgb_radiance(c, wl),
+        None => scene.lights.spectrum(light, wl) * es.scale,
     }
 }
 
@@ -128,7 +129,7 @@ pub(super) struct LightPaths<'a> {
 
 impl<'a> LightPaths<'a> {
     pub fn new(scene: &'a Scene, config: &IntegratorConfig) -> Self {
-        let (center, radius) = scene.bounding_sphere();
+        let (center, radius) = scene.geometry.bounding_sphere();
         LightPaths {
             scene,
             max_depth: config.max_depth,
@@ -181,10 +182,10 @@ impl<'a> LightPaths<'a> {
                     c,
                 )));
             }
-            let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
+            let Some((prim, hit)) = scene.geometry.intersect(&ray, f64::INFINITY) else {
                 break;
             };
-            let it = scene.interaction(&ray, prim, &hit);
+            let it = scene.geometry.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
             let Some(bsdf) = scene.bsdf(&it, wo, wl) else {
                 break;

@@ -98,6 +98,7 @@ impl<'a> LightTracer<'a> {
                 let shadow = Ray::new(origin, c.lens_point - origin).at_time(time);
                 if !self
                     .scene
+                    .geometry
                     .occluded(&shadow, 1.0 - 1e-9, Coherence::Incoherent)
                 {
                     self.splat(c.raster, a.beta * f * (c.we / c.pdf), wl, counts);
@@ -144,11 +145,12 @@ impl<'a> LightTracer<'a> {
         let shadow = Ray::new(c.lens_point, q - c.lens_point).at_time(time);
         if self
             .scene
+            .geometry
             .occluded(&shadow, 1.0 - 1e-4, Coherence::Incoherent)
         {
             return None;
         }
-        let l = self.scene.light_spectrum(index, wl);
+        let l = self.scene.lights.spectrum(index, wl);
         Some((c.raster, l * (geometric * c.we / (c.pdf * pmf))))
     }
 

@@ -231,9 +231,9 @@ fn record_hit(
     distance: f64,
 ) {
     record(tree, node, |n| {
-        n.object = Some(scene.object_names[prim as usize].clone());
-        let m = scene.primitives[prim as usize].material as usize;
-        n.material = Some(scene.material_names[m].clone());
+        n.object = Some(scene.geometry.names[prim as usize].clone());
+        let m = scene.geometry.primitives[prim as usize].material as usize;
+        n.material = Some(scene.materials.names[m].clone());
         n.distance = Some(distance);
     });
 }

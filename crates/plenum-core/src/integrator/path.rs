@@ -75,7 +75,7 @@ impl<'a> PathTracer<'a> {
                     Color::from(beta.0),
                 ))
             });
-            let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
+            let Some((prim, hit)) = scene.geometry.intersect(&ray, f64::INFINITY) else {
                 let d = ray.direction.normalized();
                 let le = direct::infinite_mis(scene, d, wl, pdf_bsdf, 1.0);
                 l += beta * le;
@@ -86,14 +86,14 @@ impl<'a> PathTracer<'a> {
                 });
                 break;
             };
-            let it = scene.interaction(&ray, prim, &hit);
+            let it = scene.geometry.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
             record_hit(&mut tree, node, scene, prim, hit.t * ray.direction.length());
 
             // Light the path finds on its own, weighed against light sampling's chance of
             // having found it.
             let before = l;
-            if let Some(light) = scene.light_of(prim) {
+            if let Some(light) = scene.lights.of_primitive(prim) {
                 let le = direct::emitted_mis(scene, light, &it, wo, wl, pdf_bsdf, previous, 1.0);
                 l += beta * le;
             } else if let Some(ke) = scene.phong_emission(&it, wl) {

@@ -44,6 +44,7 @@ use super::{
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
 use crate::color::Color;
+use crate::material::rgb_radiance;
 use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::sampling::SampleStream;
 use crate::scene::{Interaction, Scene};
@@ -144,15 +145,15 @@ impl<'a> PhotonMapper<'a> {
                 ))
             });
             parent = node;
-            let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
+            let Some((prim, hit)) = scene.geometry.intersect(&ray, f64::INFINITY) else {
                 let d = ray.direction.normalized();
                 l += beta * direct::infinite_mis(scene, d, wl, pdf_bsdf, 1.0);
                 break;
             };
-            let it = scene.interaction(&ray, prim, &hit);
+            let it = scene.geometry.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
             record_hit(&mut tree, node, scene, prim, hit.t * ray.direction.length());
-            if let Some(light) = scene.light_of(prim) {
+            if let Some(light) = scene.lights.of_primitive(prim) {
                 l += beta * direct::emitted_mis(scene, light, &it, wo, wl, pdf_bsdf, previous, 1.0);
             } else if let Some(ke) = scene.phong_emission(&it, wl) {
                 l += beta * ke;
@@ -296,7 +297,7 @@ impl<'a> PhotonMapper<'a> {
                 if w.is_black() {
                     break;
                 }
-                let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
+                let Some((prim, hit)) = scene.geometry.intersect(&ray, f64::INFINITY) else {
                     let d = ray.direction.normalized();
                     sum += w * escaped(scene, d, wl, delta);
                     if !delta && ez == first {
@@ -304,14 +305,14 @@ impl<'a> PhotonMapper<'a> {
                     }
                     break;
                 };
-                let it = scene.interaction(&ray, prim, &hit);
+                let it = scene.geometry.interaction(&ray, prim, &hit);
                 let wo_z = -ray.direction.normalized();
                 // A light's surface may also carry a Phong k_e (its colour under Whitted): it
                 // is a light here, found under MIS at the first hit and by the caustic map
                 // after that; k_e alone, which no photon leaves, counts wherever it is seen.
                 if delta {
                     sum += w * emitted(scene, prim, &it, wo_z, wl);
-                } else if let Some(light) = scene.light_of(prim) {
+                } else if let Some(light) = scene.lights.of_primitive(prim) {
                     if ez == first {
                         let le = direct::emitted_mis(scene, light, &it, wo_z, wl, pdf_bsdf, x.p, n);
                         sum += w * le;
@@ -417,7 +418,7 @@ impl<'a> PhotonMapper<'a> {
                 continue;
             }
             let power = Color::new(ph.power[0] as f64, ph.power[1] as f64, ph.power[2] as f64);
-            sum += f * signed_radiance(self.scene, power, wl) * shading_correction(it, wi);
+            sum += f * signed_radiance(power, wl) * shading_correction(it, wi);
             if let Some(list) = found_photons.as_deref_mut() {
                 let position = Vec3::new(ph.p[0] as f64, ph.p[1] as f64, ph.p[2] as f64);
                 list.push(FoundPhoton {
@@ -442,21 +443,21 @@ impl PhotonConfig {
         if self.radius > 0.0 {
             self.radius
         } else {
-            0.1 * scene.scene_radius()
+            0.1 * scene.geometry.radius()
         }
     }
 }
 
 /// A photon's flux, linear sRGB of any sign, as a spectrum at `wl`: the fitted spectrum of
 /// its positive channels minus that of its negative ones, whose colour is the flux's own.
-fn signed_radiance(scene: &Scene, c: Color, wl: &SampledWavelengths) -> SampledSpectrum {
+fn signed_radiance(c: Color, wl: &SampledWavelengths) -> SampledSpectrum {
     let positive = Color::new(c.r.max(0.0), c.g.max(0.0), c.b.max(0.0));
     let negative = Color::new(positive.r - c.r, positive.g - c.g, positive.b - c.b);
-    let s = scene.rgb_radiance(positive, wl);
+    let s = rgb_radiance(positive, wl);
     if negative == Color::BLACK {
         return s;
     }
-    s - scene.rgb_radiance(negative, wl)
+    s - rgb_radiance(negative, wl)
 }
 
 fn f32s(v: Vec3) -> [f32; 3] {

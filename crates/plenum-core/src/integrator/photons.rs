@@ -92,9 +92,9 @@ pub(super) fn emitted(
     wo: Vec3,
     wl: &SampledWavelengths,
 ) -> SampledSpectrum {
-    if let Some(light) = scene.light_of(prim) {
+    if let Some(light) = scene.lights.of_primitive(prim) {
         if scene.lights[light as usize].emits_toward(it.n, wo) {
-            return scene.light_spectrum(light, wl);
+            return scene.lights.spectrum(light, wl);
         }
     } else if let Some(ke) = scene.phong_emission(it, wl) {
         return ke;
@@ -112,8 +112,8 @@ pub(super) fn escaped(
 ) -> SampledSpectrum {
     let mut le = SampledSpectrum::ZERO;
     if lights {
-        for &i in &scene.infinite_lights {
-            le += scene.radiance_from_infinity(i, d, wl);
+        for &i in &scene.lights.infinite {
+            le += scene.lights.radiance_from_infinity(i, d, wl);
         }
     }
     le

@@ -436,7 +436,7 @@ impl Eye<'_> {
                 ))
             });
             parent = node;
-            let Some((prim, hit)) = scene.intersect(&ray, f64::INFINITY) else {
+            let Some((prim, hit)) = scene.geometry.intersect(&ray, f64::INFINITY) else {
                 let d = ray.direction.normalized();
                 l += beta * infinite_mis(scene, d, &wl, pdf_bsdf, 1.0);
                 record(&mut tree, node, |n| n.stops.push(Stop::Miss));
@@ -445,9 +445,9 @@ impl Eye<'_> {
             let t = hit.t * ray.direction.length();
             distance += t;
             record_hit(&mut tree, node, scene, prim, t);
-            let it = scene.interaction(&ray, prim, &hit);
+            let it = scene.geometry.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
-            if let Some(light) = scene.light_of(prim) {
+            if let Some(light) = scene.lights.of_primitive(prim) {
                 l += beta * emitted_mis(scene, light, &it, wo, &wl, pdf_bsdf, previous, 1.0);
             } else if let Some(ke) = scene.phong_emission(&it, &wl) {
                 l += beta * ke;

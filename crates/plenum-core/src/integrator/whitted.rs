@@ -114,20 +114,20 @@ impl<'a> Whitted<'a> {
                 b.weight,
             ))
         });
-        let Some((prim, hit)) = self.scene.intersect(ray, f64::INFINITY) else {
+        let Some((prim, hit)) = self.scene.geometry.intersect(ray, f64::INFINITY) else {
             if let (Some(t), Some(i)) = (b.tree.as_deref_mut(), node) {
                 t.nodes[i].stops.push(Stop::Miss);
                 t.nodes[i].color = self.scene.background;
             }
             return self.scene.background;
         };
-        let it = self.scene.interaction(ray, prim, &hit);
+        let it = self.scene.geometry.interaction(ray, prim, &hit);
         let k = self.scene.coefficients(&it);
         if let (Some(t), Some(i)) = (b.tree.as_deref_mut(), node) {
             let n = &mut t.nodes[i];
-            n.object = Some(self.scene.object_names[prim as usize].clone());
-            let m = self.scene.primitives[prim as usize].material as usize;
-            n.material = Some(self.scene.material_names[m].clone());
+            n.object = Some(self.scene.geometry.names[prim as usize].clone());
+            let m = self.scene.geometry.primitives[prim as usize].material as usize;
+            n.material = Some(self.scene.materials.names[m].clone());
             n.distance = Some(hit.t * ray.direction.length());
         }
 
@@ -142,7 +142,7 @@ impl<'a> Whitted<'a> {
         let mut color = k.emissive + k.ambient * self.scene.ambient;
         // A physically based area light's surface shows its radiance (a Phong emitter's
         // k_e already does).
-        if let Some(l) = self.scene.light_of(prim) {
+        if let Some(l) = self.scene.lights.of_primitive(prim) {
             let light = &self.scene.lights[l as usize];
             if self.scene.material_of(prim).is_physical() && light.emits_toward(it.n, v) {
                 color += light.rgb();
@@ -203,14 +203,16 @@ impl<'a> Whitted<'a> {
         // Closed solids (and the half-space under a plane) are media the ray enters and
         // leaves. Thin sheets (polygons, disks, open shells) have no inside: light crosses them
         // unbent, as through a pane of zero thickness, and the medium stays the same.
-        let solid = self.scene.primitives[prim as usize].shape.is_closed();
+        let solid = self.scene.geometry.primitives[prim as usize]
+            .shape
+            .is_closed();
         // Whitted's model is RGB: indices at the sodium D line.
         let ior = |m| self.scene.materials[m as usize].ior_at(589.3);
         let media_t = if kt.is_black() || !solid {
             *b.media
         } else if entering {
             b.media
-                .entered(prim, self.scene.primitives[prim as usize].material)
+                .entered(prim, self.scene.geometry.primitives[prim as usize].material)
         } else {
             b.media.left(prim)
         };
@@ -328,19 +330,21 @@ impl<'a> Whitted<'a> {
         // rays do not follow the last pixel's closely enough for the branch predictor
         // (walked as coherent, a bunny lit by two point lights rendered 9 % slower).
         let walk = Coherence::Incoherent;
-        self.scene.for_each_hit(&ray, t_max, walk, |prim, hit| {
-            if recording {
-                occluders.push((hit.t, prim));
-            }
-            if self.scene.is_transmissive(prim) {
-                let occ = self.scene.interaction(&ray, prim, hit);
-                s *= self.scene.coefficients(&occ).transmissive;
-            } else {
-                s = Color::BLACK;
-            }
-            // Once black, nothing further can let light through.
-            !s.is_black() || recording
-        });
+        self.scene
+            .geometry
+            .for_each_hit(&ray, t_max, walk, |prim, hit| {
+                if recording {
+                    occluders.push((hit.t, prim));
+                }
+                if self.scene.geometry.is_transmissive(prim) {
+                    let occ = self.scene.geometry.interaction(&ray, prim, hit);
+                    s *= self.scene.coefficients(&occ).transmissive;
+                } else {
+                    s = Color::BLACK;
+                }
+                // Once black, nothing further can let light through.
+                !s.is_black() || recording
+            });
         if let Some(t) = b.tree.as_deref_mut() {
             occluders.sort_by(|a, b| a.0.total_cmp(&b.0));
             let mut node = RayNode::new(
@@ -354,10 +358,10 @@ impl<'a> Whitted<'a> {
             node.distance = Some(inc.distance);
             node.color = s * inc.intensity;
             node.shadow = Some(ShadowInfo {
-                light: self.scene.light_names[light].clone(),
+                light: self.scene.lights.names[light].clone(),
                 occluders: occluders
                     .iter()
-                    .map(|&(_, p)| self.scene.object_names[p as usize].clone())
+                    .map(|&(_, p)| self.scene.geometry.names[p as usize].clone())
                     .collect(),
                 blocked: s.is_black(),
                 transmittance: s,

@@ -11,8 +11,8 @@ mod phong;
 mod physical;
 
 pub use param::{
-    scaled, source_rgb, uplift, uplift_illuminant, FloatTexture, SpectralTexture, SpectrumKind,
-    SpectrumValue,
+    rgb_radiance, scaled, source_rgb, uplift, uplift_illuminant, FloatTexture, SpectralTexture,
+    SpectrumKind, SpectrumValue,
 };
 pub use phong::{Coefficients, PhongMaterial};
 pub use physical::{

@@ -217,6 +217,17 @@ pub fn uplift_illuminant(c: Color, wl: &SampledWavelengths) -> SampledSpectrum {
     uplift_at(c, SpectrumKind::Illuminant, wl)
 }
 
+/// Radiance given as linear RGB (a Phong k_e, an environment map's), at the sample's
+/// wavelengths: the three channels themselves in RGB mode, else an illuminant spectrum.
+#[inline]
+pub fn rgb_radiance(c: Color, wl: &SampledWavelengths) -> SampledSpectrum {
+    if wl.is_rgb() {
+        SampledSpectrum([c.r, c.g, c.b, 0.0])
+    } else {
+        uplift_illuminant(c, wl)
+    }
+}
+
 /// `s` times `k`, as a spectrum of the same kind.
 pub fn scaled(s: &Spectrum, k: f64) -> Spectrum {
     if k == 1.0 {

@@ -1,0 +1,147 @@
+//! A shape placed in the world (a transform, perhaps moving, and a material), and a hit on it
+//! in world space.
+
+use crate::accel::Coherence;
+use crate::geometry::{HitRecord, Shape};
+use crate::material::MaterialId;
+use crate::math::{gamma, Bounds3, Motion, Ray, Transform, Vec3};
+use crate::texture::TextureCoords;
+use std::sync::Arc;
+
+/// A shape placed in the world with a material.
+#[derive(Clone, Debug)]
+pub struct Primitive {
+    pub shape: Shape,
+    /// Object-to-world transform; `None` when the shape is already in world coordinates.
+    pub to_world: Option<Box<Transform>>,
+    /// For an object that moves while the shutter is open: its transforms at times 0 and 1,
+    /// which replace `to_world` (the pose at time 0).
+    pub motion: Option<Box<Motion>>,
+    pub material: MaterialId,
+    /// For meshes: a material per vertex, blended across each triangle by its barycentric
+    /// coordinates (the course `.ray` format's per-vertex materials). Replaces `material`.
+    pub vertex_materials: Option<Arc<Vec<MaterialId>>>,
+}
+
+/// Everything the integrator needs about a hit, in world space.
+#[derive(Clone, Copy, Debug)]
+pub struct Interaction {
+    pub p: Vec3,
+    pub p_error: Vec3,
+    /// Unit geometric normal, outward for solids.
+    pub n: Vec3,
+    /// Unit shading normal, on the same side as `n`.
+    pub shading_n: Vec3,
+    pub texture: TextureCoords,
+    pub primitive: u32,
+    /// The shape's record of the hit: which triangle, and where in it.
+    pub hit: HitRecord,
+}
+
+impl Primitive {
+    /// Calls `f` with the object-to-world transform at `time` (`None`: identity).
+    #[inline]
+    fn placed<R>(&self, time: f64, f: impl FnOnce(Option<&Transform>) -> R) -> R {
+        match &self.motion {
+            None => f(self.to_world.as_deref()),
+            Some(m) => f(Some(&m.at(time))),
+        }
+    }
+
+    pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
+        self.placed(ray.time, |placement| match placement {
+            None => self.shape.intersect(ray, t_max),
+            Some(t) => {
+                let (local, dt) = t.ray_to_object(ray);
+                let mut hit = self.shape.intersect(&local, t_max - dt)?;
+                hit.t += dt;
+                Some(hit)
+            }
+        })
+    }
+
+    /// The hit in world space; `want_uv` asks for texture coordinates.
+    pub fn interaction(
+        &self,
+        ray: &Ray,
+        hit: &HitRecord,
+        primitive: u32,
+        want_uv: bool,
+    ) -> Interaction {
+        self.placed(ray.time, |placement| match placement {
+            None => {
+                let g = self.shape.surface(ray, hit, want_uv);
+                Interaction {
+                    p: g.p,
+                    p_error: g.p_error,
+                    n: g.n,
+                    shading_n: g.shading_n,
+                    texture: TextureCoords {
+                        uv: g.uv,
+                        object_point: g.p,
+                    },
+                    primitive,
+                    hit: *hit,
+                }
+            }
+            Some(t) => {
+                let (local, dt) = t.ray_to_object(ray);
+                let local_hit = HitRecord {
+                    t: hit.t - dt,
+                    ..*hit
+                };
+                let g = self.shape.surface(&local, &local_hit, want_uv);
+                let (p, p_error) = t.point_with_error(g.p, g.p_error);
+                // A spawned ray is intersected in object space, where what keeps it off the
+                // surface is its distance along the object normal. Offsetting by the world
+                // error box alone falls short under anisotropic scales: require the world
+                // offset to map to more than the object-space error along the normal (that of
+                // the hit, that of taking the new origin back into object space, and that of
+                // the stored inverse itself).
+                let normal = t.normal(g.n);
+                // A degenerate normal (a shape's singular point) keeps the world's error box.
+                let stretch = normal.length().max(f64::MIN_POSITIVE);
+                let n = normal / stretch;
+                let inverse_mismatch = t.inverse_residual() * (g.p.abs().max_component() + 1.0);
+                let object_error = g.n.abs().dot(g.p_error + t.inverse_error(p))
+                    + inverse_mismatch * g.n.abs().dot(Vec3::ONE);
+                let p_error = p_error + n.abs() * (object_error / stretch * (1.0 + gamma(4)));
+                Interaction {
+                    p,
+                    p_error,
+                    n,
+                    shading_n: t.normal(g.shading_n).normalized(),
+                    texture: TextureCoords {
+                        uv: g.uv,
+                        object_point: g.p,
+                    },
+                    primitive,
+                    hit: *hit,
+                }
+            }
+        })
+    }
+
+    /// Some hit in (0, t_max), not necessarily the nearest (see [`Shape::intersect_any`]).
+    pub fn intersect_any(&self, ray: &Ray, t_max: f64, coherence: Coherence) -> Option<HitRecord> {
+        self.placed(ray.time, |placement| match placement {
+            None => self.shape.intersect_any(ray, t_max, coherence),
+            Some(t) => {
+                let (local, dt) = t.ray_to_object(ray);
+                let mut hit = self.shape.intersect_any(&local, t_max - dt, coherence)?;
+                hit.t += dt;
+                Some(hit)
+            }
+        })
+    }
+
+    /// World bounds; for a moving object, of everywhere it goes while the shutter is open.
+    pub fn world_bounds(&self) -> Option<Bounds3> {
+        let b = self.shape.bounds()?;
+        Some(match (&self.motion, &self.to_world) {
+            (Some(m), _) => m.bounds(&b),
+            (None, None) => b,
+            (None, Some(t)) => Bounds3::from_points(b.corners().map(|c| t.point(c))),
+        })
+    }
+}
