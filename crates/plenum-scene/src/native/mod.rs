@@ -1,0 +1,305 @@
+//! Plenum's native scene format: TOML, documented field by field in docs/scene-format.md.
+//!
+//! `parse` reads the top-level tables in order and hands each to its module: `settings`
+//! (`[render]`, `[camera]`), `materials` (and `physical`, the typed ones), `objects` (with
+//! `[meshes.NAME]`), `lights`. What they share (colours, textures, transforms, a `type`
+//! among several) is here.
+
+use crate::diagnostics::{did_you_mean, SceneError};
+use crate::reader::{Fields, Result, Source, Value};
+use crate::RenderDefaults;
+use plenum_core::color::Color;
+use plenum_core::geometry::TriangleMesh;
+use plenum_core::math::{Matrix4, Transform, Vec3};
+use plenum_core::scene::{MaterialId, SceneBuilder};
+use plenum_core::texture::{ImageTexture, Texture};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use toml::de::{DeTable, DeValue};
+
+const TOP_LEVEL: &[&str] = &[
+    "background",
+    "render",
+    "camera",
+    "materials",
+    "meshes",
+    "lights",
+    "objects",
+];
+mod lights;
+mod materials;
+mod objects;
+mod physical;
+mod settings;
+
+const COMMON: [&str; 5] = ["type", "name", "material", "transform", "transform_close"];
+
+/// Parses a native scene. `base_dir` resolves relative paths (meshes, textures).
+/// Also returns warnings: statements of referenced mesh files that were read past.
+pub fn parse(
+    path: &Path,
+    text: &str,
+    base_dir: &Path,
+) -> Result<(SceneBuilder, RenderDefaults, Vec<String>)> {
+    let doc = DeTable::parse(text).map_err(|e| {
+        let span = e.span().unwrap_or(0..0);
+        SceneError::at(path, text, span, e.message().trim().to_string())
+    })?;
+    let src = Source { path, text };
+    let top = Fields::new(src, doc.get_ref(), doc.span(), "the scene", TOP_LEVEL)?;
+    let mut reader = Reader {
+        src,
+        base_dir: base_dir.to_path_buf(),
+        builder: SceneBuilder::default(),
+        materials: HashMap::new(),
+        meshes: HashMap::new(),
+        warnings: Vec::new(),
+    };
+    if let Some(v) = top.get("background") {
+        reader.builder.background = reader.color(v)?;
+    }
+    let mut defaults = RenderDefaults::default();
+    if let Some(v) = top.get("render") {
+        reader.render(v, &mut defaults)?;
+    }
+    if let Some(v) = top.get("camera") {
+        reader.camera(v, &mut defaults)?;
+    }
+    if let Some(v) = top.get("materials") {
+        let DeValue::Table(t) = v.get_ref() else {
+            return Err(src.error(
+                v.span(),
+                "expected a table of named materials: [materials.NAME]",
+            ));
+        };
+        for (name, value) in t.iter() {
+            reader.material(name.get_ref(), value)?;
+        }
+    }
+    if let Some(v) = top.get("meshes") {
+        let DeValue::Table(t) = v.get_ref() else {
+            return Err(src.error(v.span(), "expected a table of named meshes: [meshes.NAME]"));
+        };
+        for (name, value) in t.iter() {
+            let f = src.table(
+                value,
+                &format!("mesh `{}`", name.get_ref()),
+                &["file", "positions", "indices", "normals", "uvs"],
+            )?;
+            let mesh = reader.mesh_data(&f)?;
+            reader.meshes.insert(name.get_ref().to_string(), mesh);
+        }
+    }
+    if let Some(v) = top.get("lights") {
+        for (i, light) in src
+            .array(v, "an array of lights: [[lights]]")?
+            .iter()
+            .enumerate()
+        {
+            reader.light(i, light)?;
+        }
+    }
+    if let Some(v) = top.get("objects") {
+        for (i, object) in src
+            .array(v, "an array of objects: [[objects]]")?
+            .iter()
+            .enumerate()
+        {
+            reader.object(i, object)?;
+        }
+    }
+    Ok((reader.builder, defaults, reader.warnings))
+}
+
+struct Reader<'s> {
+    src: Source<'s>,
+    base_dir: PathBuf,
+    builder: SceneBuilder,
+    materials: HashMap<String, MaterialId>,
+    meshes: HashMap<String, Arc<TriangleMesh>>,
+    warnings: Vec<String>,
+}
+
+impl<'s> Reader<'s> {
+    /// A colour: `[r, g, b]`, a grey level, or a texture table.
+    fn color(&self, v: &Value<'s>) -> Result<Color> {
+        match v.get_ref() {
+            DeValue::Integer(_) | DeValue::Float(_) => {
+                let g = self.src.number(v)?;
+                self.non_negative(v, Color::gray(g))
+            }
+            _ => {
+                let c = self
+                    .src
+                    .numbers::<3>(v, "a colour: [r, g, b] or a number")?;
+                self.non_negative(v, Color::new(c[0], c[1], c[2]))
+            }
+        }
+    }
+
+    fn non_negative(&self, v: &Value<'s>, c: Color) -> Result<Color> {
+        if c.r < 0.0 || c.g < 0.0 || c.b < 0.0 {
+            Err(self.src.error(v.span(), "expected colour components ≥ 0"))
+        } else {
+            Ok(c)
+        }
+    }
+
+    fn texture(&self, v: &Value<'s>) -> Result<Texture> {
+        let DeValue::Table(_) = v.get_ref() else {
+            return Ok(Texture::Constant(self.color(v)?));
+        };
+        let kind = {
+            let f = self
+                .src
+                .table(v, "a texture", &["texture", "even", "odd", "scale", "file"])?;
+            let k = f.required("texture")?;
+            (self.src.string(k)?.to_string(), k.span())
+        };
+        match kind.0.as_str() {
+            "checker" | "checker3d" => {
+                let f =
+                    self.src
+                        .table(v, "a checker texture", &["texture", "even", "odd", "scale"])?;
+                let even = f.get("even").map_or(Ok(Color::WHITE), |c| self.color(c))?;
+                let odd = f.get("odd").map_or(Ok(Color::BLACK), |c| self.color(c))?;
+                let scale = f.positive("scale", Some(1.0))?;
+                Ok(if kind.0 == "checker" {
+                    Texture::Checker2d { even, odd, scale }
+                } else {
+                    Texture::Checker3d { even, odd, scale }
+                })
+            }
+            "image" => {
+                let f = self
+                    .src
+                    .table(v, "an image texture", &["texture", "file", "scale"])?;
+                let file = f.required("file")?;
+                let path = self.base_dir.join(self.src.string(file)?);
+                let texels = plenum_image::read_texture(&path)
+                    .map_err(|e| self.src.error(file.span(), e.to_string()))?;
+                let scale = match f.get("scale") {
+                    None => [1.0, 1.0],
+                    Some(s) => {
+                        let r = self.src.numbers::<2>(s, "[u, v] repeats")?;
+                        if r[0] <= 0.0 || r[1] <= 0.0 {
+                            return Err(self.src.error(s.span(), "expected repeats > 0"));
+                        }
+                        r
+                    }
+                };
+                let (width, height) = (texels.width, texels.height);
+                let texels = texels
+                    .rgb
+                    .iter()
+                    .map(|p| Color::new(p[0] as f64, p[1] as f64, p[2] as f64))
+                    .collect();
+                let image = ImageTexture::new(width, height, texels, scale)
+                    .ok_or_else(|| self.src.error(file.span(), "the image is empty"))?;
+                Ok(Texture::Image(Arc::new(image)))
+            }
+            other => {
+                let e = self.src.error(kind.1, format!("unknown texture `{other}`"));
+                Err(
+                    match did_you_mean(other, ["checker", "checker3d", "image"]) {
+                        Some(s) => e.with_help(format!("did you mean `{s}`?")),
+                        None => e.with_help("expected one of: checker, checker3d, image"),
+                    },
+                )
+            }
+        }
+    }
+
+    /// The `type` of a light or object, checked against the known kinds.
+    fn kind(&self, v: &Value<'s>, what: &str, kinds: &[&'static str]) -> Result<String> {
+        let DeValue::Table(t) = v.get_ref() else {
+            return Err(self
+                .src
+                .error(v.span(), format!("expected a table for {what}")));
+        };
+        let Some(k) = t.get("type") else {
+            let start = v.span().start;
+            let end = self.src.text[start..]
+                .find('\n')
+                .map_or(self.src.text.len(), |i| start + i);
+            return Err(self
+                .src
+                .error(start..end, format!("missing field `type` in {what}"))
+                .with_help(format!("expected one of: {}", kinds.join(", "))));
+        };
+        let kind = self.src.string(k)?;
+        if kinds.contains(&kind) {
+            return Ok(kind.to_string());
+        }
+        let e = self
+            .src
+            .error(k.span(), format!("unknown type `{kind}` for {what}"));
+        Err(match did_you_mean(kind, kinds.iter().copied()) {
+            Some(s) => e.with_help(format!("did you mean `{s}`?")),
+            None => e.with_help(format!("expected one of: {}", kinds.join(", "))),
+        })
+    }
+
+    /// A list of transform steps, the first applied first.
+    fn transform(&self, v: &Value<'s>) -> Result<Transform> {
+        let src = self.src;
+        let steps: Vec<&Value<'s>> = match v.get_ref() {
+            DeValue::Table(_) => vec![v],
+            _ => src
+                .array(v, "a list of transforms [{ translate = … }, …]")?
+                .iter()
+                .collect(),
+        };
+        let mut total = Transform::IDENTITY;
+        for step in steps {
+            let f = src.table(
+                step,
+                "a transform step",
+                &["translate", "rotate", "scale", "matrix"],
+            )?;
+            let (key, value) = match ["translate", "rotate", "scale", "matrix"].iter().filter_map(|k| f.get(k).map(|v| (*k, v))).collect::<Vec<_>>()[..] {
+                [one] => one,
+                _ => return Err(src.error(step.span(), "expected exactly one of translate, rotate, scale or matrix in each transform step")),
+            };
+            let t = match key {
+                "translate" => Some(Transform::translate(src.vec3(value)?)),
+                "rotate" => {
+                    let r = src.table(value, "a rotation", &["axis", "degrees"])?;
+                    Transform::rotate(
+                        r.direction("axis", None)?,
+                        r.src.number(r.required("degrees")?)?,
+                    )
+                }
+                "scale" => {
+                    let s = match value.get_ref() {
+                        DeValue::Array(_) => src.vec3(value)?,
+                        _ => Vec3::splat(src.number(value)?),
+                    };
+                    Transform::scale(s)
+                }
+                _ => {
+                    let rows = src.array(value, "a 4×4 matrix: 4 rows of 4 numbers")?;
+                    if rows.len() != 4 {
+                        return Err(
+                            src.error(value.span(), "expected a 4×4 matrix: 4 rows of 4 numbers")
+                        );
+                    }
+                    let mut m = [[0.0; 4]; 4];
+                    for (row, r) in m.iter_mut().zip(rows) {
+                        *row = src.numbers::<4>(r, "a matrix row of 4 numbers")?;
+                    }
+                    Transform::from_matrix(Matrix4(m))
+                }
+            };
+            let t = t.ok_or_else(|| {
+                src.error(
+                    value.span(),
+                    format!("this {key} is singular or not affine: it cannot be inverted"),
+                )
+            })?;
+            total = t.after(&total);
+        }
+        Ok(total)
+    }
+}
