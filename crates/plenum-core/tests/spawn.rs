@@ -135,6 +135,7 @@ fn spawned_rays_never_rehit_their_surface() {
                 to_world,
                 motion: None,
                 material: 0,
+                light: None,
             };
             let Some(bounds) = prim.world_bounds() else {
                 continue;

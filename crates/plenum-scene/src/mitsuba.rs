@@ -850,7 +850,7 @@ impl<'d> Builder<'d> {
     }
 
     /// The material a shape scatters with: its BSDF, or Mitsuba's default.
-    fn shape_material(&mut self, o: usize, emits: Option<Color>) -> Result<MaterialId> {
+    fn shape_material(&mut self, o: usize, emits: bool) -> Result<MaterialId> {
         let bsdfs = self.children(o, "bsdf")?;
         if let Some((_, p)) = bsdfs.get(1) {
             return Err(self.doc.error(&p.loc, "a shape has one BSDF"));
@@ -858,11 +858,9 @@ impl<'d> Builder<'d> {
         if let Some(&(b, _)) = bsdfs.first() {
             return self.material(b, self.obj(o).id.as_deref());
         }
-        if let Some(radiance) = emits {
+        if emits {
             // Mitsuba gives an emitter without a BSDF a black diffuse one.
-            let name = format!("{} (emitter)", self.obj(o).id.as_deref().unwrap_or("shape"));
-            let id = self.builder.add_material(name, Material::emitter(radiance));
-            return Ok(id);
+            return Ok(self.builder.black_material());
         }
         if let Some(id) = self.default_diffuse {
             return Ok(id);
@@ -980,7 +978,7 @@ impl<'d> Builder<'d> {
         }
         let name = self.name(o);
         let Some(&(e, ep)) = emitters.first() else {
-            let material = self.shape_material(o, None)?;
+            let material = self.shape_material(o, false)?;
             self.builder.add_object(name, shape, to_world, material);
             return Ok(());
         };
@@ -995,7 +993,7 @@ impl<'d> Builder<'d> {
             ));
         }
         let (radiance, spectrum) = self.emission(e, "radiance")?;
-        let material = self.shape_material(o, Some(radiance))?;
+        let material = self.shape_material(o, true)?;
         let added = self
             .builder
             .add_emissive_object(name, shape, to_world, material, radiance, false, 1);

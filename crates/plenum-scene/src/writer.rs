@@ -107,15 +107,12 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
         let _ = writeln!(w, "left_handed = true");
     }
     let _ = writeln!(w);
-    // Objects that show an area light are written with their light.
-    let mut shows_light: HashMap<u32, usize> = HashMap::new();
-    for (i, o) in scene.lights.objects.iter().enumerate() {
-        if let Some(o) = o {
-            shows_light.insert(*o, i);
-        }
-    }
     let keys = unique_keys(&scene.materials.names, "material");
+    let written = written_materials(scene);
     for (i, (key, m)) in keys.iter().zip(&scene.materials).enumerate() {
+        if !written[i] {
+            continue;
+        }
         let _ = writeln!(w, "[materials.{}]", quote(key));
         let m = match m {
             Material::Phong(m) => m,
@@ -174,12 +171,19 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
             color(scene.ambient)
         );
     }
+    // Per light: the object that shows it, for area lights.
+    let mut surface = vec![None; scene.lights.len()];
+    for (i, p) in scene.geometry.primitives.iter().enumerate() {
+        if let Some(l) = p.light {
+            surface[l as usize] = Some(i);
+        }
+    }
     for (i, (light, name)) in scene.lights.iter().zip(&scene.lights.names).enumerate() {
         // The background is written as `background`, not as a light.
         if Some(i as u32) == scene.lights.background {
             continue;
         }
-        if written_with_object(scene, i) {
+        if surface[i].is_some_and(|p| written_with_object(scene, p)) {
             // Written as its object, with `emission`.
             continue;
         }
@@ -304,8 +308,8 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
         .zip(&scene.geometry.names)
         .enumerate()
     {
-        let light = shows_light.get(&(index as u32)).copied();
-        let _ = match light.map(|i| (i, &scene.lights[i])) {
+        // An object that shows an area light is written with its light.
+        let _ = match p.light.map(|i| (i as usize, &scene.lights[i as usize])) {
             Some((
                 i,
                 Light::Area {
@@ -314,9 +318,9 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                     two_sided,
                     ..
                 },
-            )) if written_with_object(scene, i) => {
+            )) if written_with_object(scene, index) => {
                 let m = &scene.materials[p.material as usize];
-                let material = if m.is_emitter_only() {
+                let material = if m.reflects_nothing() {
                     String::new()
                 } else {
                     format!("\nmaterial = {}", quote(&keys[p.material as usize]))
@@ -392,20 +396,45 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
     out
 }
 
-/// An area light that is written as its object's `emission`: a mesh light, or any object
-/// with a material of its own; the lights of docs/scene-format.md's rectangle, disk and sphere
-/// kind are written as lights.
-fn written_with_object(scene: &Scene, light: usize) -> bool {
-    let Some(prim) = scene.lights.objects[light] else {
-        return false;
-    };
-    let emitter_only = scene.materials[scene.geometry.primitives[prim as usize].material as usize]
-        .is_emitter_only();
-    let mesh = matches!(
-        scene.geometry.primitives[prim as usize].shape,
-        Shape::Mesh(_)
-    );
-    mesh || !emitter_only
+/// Per material: whether it is written. A black material that no written object or mix
+/// names (the surface of an area light, written as its light) is left out.
+fn written_materials(scene: &Scene) -> Vec<bool> {
+    let mut named = vec![false; scene.materials.len()];
+    for p in &scene.geometry.primitives {
+        if p.light.is_some() && scene.materials[p.material as usize].reflects_nothing() {
+            continue;
+        }
+        named[p.material as usize] = true;
+        for &m in p.vertex_materials.iter().flat_map(|ids| ids.iter()) {
+            named[m as usize] = true;
+        }
+    }
+    for m in &scene.materials {
+        if let Material::Mix { materials, .. } = m {
+            for &id in materials {
+                named[id as usize] = true;
+            }
+        }
+    }
+    scene
+        .materials
+        .iter()
+        .zip(named)
+        .map(|(m, named)| {
+            named
+                || !m
+                    .phong()
+                    .is_some_and(|p| p.reflects_nothing() && p.emissive.is_black())
+        })
+        .collect()
+}
+
+/// Whether primitive `prim`, an area light's surface, is written as an object with an
+/// `emission`: a mesh light, or any object with a material of its own; the lights of
+/// docs/scene-format.md's rectangle, disk and sphere kind are written as lights.
+fn written_with_object(scene: &Scene, prim: usize) -> bool {
+    let p = &scene.geometry.primitives[prim];
+    matches!(p.shape, Shape::Mesh(_)) || !scene.materials[p.material as usize].reflects_nothing()
 }
 
 /// A physically based material's keys (after its `[materials.NAME]` line).

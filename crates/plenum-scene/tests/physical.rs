@@ -462,7 +462,7 @@ transform = [{ translate = [-4, 0, 0] }]
                 .geometry
                 .intersect(&ray, 0.02)
                 .unwrap_or_else(|| panic!("light {i}: sampled point {p:?} is not on the surface"));
-            assert_eq!(s.lights.of_primitive(prim), Some(i as u32), "light {i}");
+            assert_eq!(s.area_light(prim), Some(i as u32), "light {i}");
             let it = s.geometry.interaction(&ray, prim, &hit);
             assert!(
                 it.n.dot(n) > 0.999,

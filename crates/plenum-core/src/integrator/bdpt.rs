@@ -482,7 +482,7 @@ impl<'a> BidirectionalPathTracer<'a> {
                 ns: it.shading_n,
                 wo,
                 bsdf,
-                light: scene.lights.of_primitive(prim),
+                light: scene.area_light(prim),
                 infinite: false,
                 toward_light: Vec3::ZERO,
                 beta,

@@ -191,7 +191,7 @@ pub(super) fn bsdf_sample_ld(
         let d = bs.wi.normalized();
         return beta * infinite_mis(scene, d, wl, pdf_bsdf, 1.0);
     };
-    match scene.lights.of_primitive(prim) {
+    match scene.area_light(prim) {
         Some(light) => {
             let hit_it = scene.geometry.interaction(&ray, prim, &hit);
             beta * emitted_mis(scene, light, &hit_it, -bs.wi, wl, pdf_bsdf, it.p, 1.0)

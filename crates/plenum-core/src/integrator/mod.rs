@@ -336,6 +336,109 @@ mod tests {
         }
     }
 
+    /// An area light's surface is a black primitive that names its light: every method
+    /// sees the light's own emission on the side it emits to and nothing behind it. Two
+    /// one-sided lamps of radiance (2, 3, 4) side by side, the left facing the camera, the
+    /// right facing away; each pixel's camera ray must return exactly the radiance or zero.
+    /// Light tracing is left out: it sees emitters only through splats (the references
+    /// test those).
+    #[test]
+    fn every_method_sees_an_area_light_on_its_emitting_side_only() {
+        use crate::camera::CameraSettings;
+        use crate::geometry::{Polygon, Shape};
+        use crate::math::{Transform, Vec3};
+        use crate::scene::SceneBuilder;
+        const SIZE: u32 = 16;
+        let mut b = SceneBuilder::default();
+        b.camera = CameraSettings {
+            position: Vec3::new(0.0, 0.0, 4.0),
+            look_at: Vec3::ZERO,
+            fov_degrees: 40.0,
+            ..CameraSettings::default()
+        };
+        let radiance = Color::new(2.0, 3.0, 4.0);
+        let quad = |x0: f64, x1: f64| {
+            let c = [
+                Vec3::new(x0, -1.0, 0.0),
+                Vec3::new(x1, -1.0, 0.0),
+                Vec3::new(x1, 1.0, 0.0),
+                Vec3::new(x0, 1.0, 0.0),
+            ];
+            // Counter-clockwise seen from +z: the normal points to the camera.
+            let corners = if x0 < 0.0 {
+                c.to_vec()
+            } else {
+                c.iter().rev().copied().collect()
+            };
+            Shape::Polygon(Box::new(Polygon::new(corners).expect("a square")))
+        };
+        for (name, x0, x1) in [("front", -1.2, -0.1), ("back", 0.1, 1.2)] {
+            let black = b.black_material();
+            let placed = b.add_emissive_object(
+                name,
+                quad(x0, x1),
+                Transform::IDENTITY,
+                black,
+                radiance,
+                false,
+                1,
+            );
+            assert!(placed);
+        }
+        let scene = b.build();
+        // The light's radiance lives in the light alone: the one material is black.
+        assert_eq!(scene.materials.len(), 1);
+        assert!(scene.materials[0].reflects_nothing());
+        let camera = Camera::new(&scene.camera, SIZE, SIZE);
+        let facing = scene.geometry.primitives[0]
+            .light
+            .expect("the front lamp's light");
+        assert!(scene.lights[facing as usize].emits_toward(Vec3::Z, Vec3::Z));
+        for kind in [
+            IntegratorKind::Local,
+            IntegratorKind::Appel,
+            IntegratorKind::Whitted,
+            IntegratorKind::Path,
+            IntegratorKind::Bdpt,
+            IntegratorKind::Photon,
+        ] {
+            let config = IntegratorConfig {
+                kind,
+                color: ColorMode::Rgb,
+                photon: PhotonConfig {
+                    photons: 1000,
+                    ..PhotonConfig::default()
+                },
+                ..IntegratorConfig::default()
+            };
+            let splats = SplatBuffer::new(SIZE, SIZE, 1.0);
+            let integrator = Integrator::new(&scene, &config, &camera, &splats, None, 5);
+            let mut counts = RayCounts::default();
+            let mut seen = [0; 3];
+            for (x, y) in (0..SIZE * SIZE).map(|i| (i % SIZE, i / SIZE)) {
+                let mut stream = SampleStream::random(Rng::for_sample(5, x, y, 0));
+                let ray = camera.sample_ray(x as f64 + 0.5, y as f64 + 0.5, [0.5; 2], 0.0);
+                let c = integrator.camera_ray(&ray, &mut stream, &mut counts, None);
+                let hit = scene
+                    .geometry
+                    .intersect(&ray, f64::INFINITY)
+                    .map(|(p, _)| p);
+                let expected = match hit {
+                    Some(0) => radiance,
+                    _ => Color::BLACK,
+                };
+                seen[hit.map_or(2, |p| p as usize)] += 1;
+                let error = [c.r - expected.r, c.g - expected.g, c.b - expected.b];
+                assert!(
+                    error.iter().all(|e| e.abs() < 1e-9),
+                    "{}: pixel ({x}, {y}) on {hit:?} gives {c:?}, expected {expected:?}",
+                    kind.name()
+                );
+            }
+            assert!(seen.iter().all(|&n| n > 0), "{seen:?}");
+        }
+    }
+
     fn green_mean(film: &Film) -> f64 {
         let pixels = film.pixels();
         pixels.iter().map(|p| p[1] as f64).sum::<f64>() / pixels.len() as f64

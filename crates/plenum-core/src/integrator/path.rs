@@ -93,7 +93,7 @@ impl<'a> PathTracer<'a> {
             // Light the path finds on its own, weighed against light sampling's chance of
             // having found it.
             let before = l;
-            if let Some(light) = scene.lights.of_primitive(prim) {
+            if let Some(light) = scene.area_light(prim) {
                 let le = direct::emitted_mis(scene, light, &it, wo, wl, pdf_bsdf, previous, 1.0);
                 l += beta * le;
             } else if let Some(ke) = scene.phong_emission(&it, wl) {

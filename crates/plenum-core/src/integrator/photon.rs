@@ -153,7 +153,7 @@ impl<'a> PhotonMapper<'a> {
             let it = scene.geometry.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
             record_hit(&mut tree, node, scene, prim, hit.t * ray.direction.length());
-            if let Some(light) = scene.lights.of_primitive(prim) {
+            if let Some(light) = scene.area_light(prim) {
                 l += beta * direct::emitted_mis(scene, light, &it, wo, wl, pdf_bsdf, previous, 1.0);
             } else if let Some(ke) = scene.phong_emission(&it, wl) {
                 l += beta * ke;
@@ -312,7 +312,7 @@ impl<'a> PhotonMapper<'a> {
                 // after that; k_e alone, which no photon leaves, counts wherever it is seen.
                 if delta {
                     sum += w * emitted(scene, prim, &it, wo_z, wl);
-                } else if let Some(light) = scene.lights.of_primitive(prim) {
+                } else if let Some(light) = scene.area_light(prim) {
                     if ez == first {
                         let le = direct::emitted_mis(scene, light, &it, wo_z, wl, pdf_bsdf, x.p, n);
                         sum += w * le;

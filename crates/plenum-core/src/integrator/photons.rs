@@ -92,7 +92,7 @@ pub(super) fn emitted(
     wo: Vec3,
     wl: &SampledWavelengths,
 ) -> SampledSpectrum {
-    if let Some(light) = scene.lights.of_primitive(prim) {
+    if let Some(light) = scene.area_light(prim) {
         if scene.lights[light as usize].emits_toward(it.n, wo) {
             return scene.lights.spectrum(light, wl);
         }

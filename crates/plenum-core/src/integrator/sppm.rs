@@ -447,7 +447,7 @@ impl Eye<'_> {
             record_hit(&mut tree, node, scene, prim, t);
             let it = scene.geometry.interaction(&ray, prim, &hit);
             let wo = -ray.direction.normalized();
-            if let Some(light) = scene.lights.of_primitive(prim) {
+            if let Some(light) = scene.area_light(prim) {
                 l += beta * emitted_mis(scene, light, &it, wo, &wl, pdf_bsdf, previous, 1.0);
             } else if let Some(ke) = scene.phong_emission(&it, &wl) {
                 l += beta * ke;

@@ -138,15 +138,18 @@ impl<'a> Whitted<'a> {
         let n = if entering { it.n } else { -it.n };
         let ns = it.shading_n.face_forward(n);
 
-        // Local illumination: emission, ambient, and Phong from every light.
-        let mut color = k.emissive + k.ambient * self.scene.ambient;
-        // A physically based area light's surface shows its radiance (a Phong emitter's
-        // k_e already does).
-        if let Some(l) = self.scene.lights.of_primitive(prim) {
-            let light = &self.scene.lights[l as usize];
-            if self.scene.material_of(prim).is_physical() && light.emits_toward(it.n, v) {
-                color += light.rgb();
+        // Local illumination: emission, ambient, and Phong from every light. An area light's
+        // surface shows its light's radiance on the side it emits to, in place of any k_e
+        // (as under the physically based methods).
+        let mut color = k.ambient * self.scene.ambient;
+        match self.scene.area_light(prim) {
+            Some(l) => {
+                let light = &self.scene.lights[l as usize];
+                if light.emits_toward(it.n, v) {
+                    color += light.rgb();
+                }
             }
+            None => color += k.emissive,
         }
         // A surface that neither diffuses nor highlights (an emitter, a mirror, clear
         // glass) needs no shadow rays.

@@ -66,11 +66,6 @@ pub enum Scattering {
 }
 
 impl Material {
-    /// The material of an area light's surface: it shows its radiance and reflects nothing.
-    pub fn emitter(radiance: Color) -> Material {
-        Material::Phong(PhongMaterial::emitter(radiance))
-    }
-
     /// The Phong model's parameters, if this is one.
     pub fn phong(&self) -> Option<&PhongMaterial> {
         match self {
@@ -79,10 +74,10 @@ impl Material {
         }
     }
 
-    /// A Phong material that only shows emitted light (an emitter's surface).
-    pub fn is_emitter_only(&self) -> bool {
+    /// A Phong material that scatters no light (an area light's surface, or k_e alone).
+    pub fn reflects_nothing(&self) -> bool {
         match self {
-            Material::Phong(m) => m.is_emitter_only(),
+            Material::Phong(m) => m.reflects_nothing(),
             _ => false,
         }
     }

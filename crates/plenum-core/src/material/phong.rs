@@ -94,11 +94,12 @@ impl Coefficients {
 }
 
 impl PhongMaterial {
-    /// The material of an area light's surface: it shows its radiance and reflects nothing.
-    pub fn emitter(radiance: Color) -> PhongMaterial {
+    /// A surface that reflects, transmits and emits nothing: an area light's surface shows
+    /// its light's emission on it.
+    pub fn black() -> PhongMaterial {
         let black = Texture::Constant(Color::BLACK);
         PhongMaterial {
-            emissive: Texture::Constant(radiance),
+            emissive: black.clone(),
             ambient: black.clone(),
             diffuse: black.clone(),
             specular: black,
@@ -138,8 +139,9 @@ impl PhongMaterial {
         }
     }
 
-    /// Everything but the emission is black: the surface only shows its light.
-    pub fn is_emitter_only(&self) -> bool {
+    /// Everything but the emission is black: the surface shows light (its own k_e, or an
+    /// area light's) and scatters none.
+    pub fn reflects_nothing(&self) -> bool {
         [
             &self.ambient,
             &self.diffuse,

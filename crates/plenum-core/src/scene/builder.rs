@@ -11,7 +11,7 @@ use crate::color::Color;
 use crate::geometry::{Disk, Polygon, Shape, Sphere};
 use crate::light::{Emitter, Light};
 use crate::light_sampler::LightSamplerKind;
-use crate::material::{Material, MaterialId};
+use crate::material::{Material, MaterialId, PhongMaterial};
 use crate::math::{Motion, Transform};
 use plenum_spectrum::Spectrum;
 use std::sync::Arc;
@@ -28,7 +28,8 @@ pub struct SceneBuilder {
     material_names: Vec<String>,
     lights: Vec<Light>,
     light_names: Vec<String>,
-    light_objects: Vec<Option<u32>>,
+    /// The material of surfaces that only show their area light's emission.
+    black: Option<MaterialId>,
     /// Per light: a spectrum given in place of its RGB value, and a scale.
     light_spectra: Vec<Option<(Spectrum, f64)>>,
     one_sided: Vec<MaterialId>,
@@ -92,10 +93,30 @@ impl SceneBuilder {
                 two_sided,
             },
         );
-        if let Some(last) = self.light_objects.last_mut() {
-            *last = Some((self.primitives.len() - 1) as u32);
-        }
+        self.show_last_light_on_last_object();
         true
+    }
+
+    /// The material of a surface that only shows its area light's emission: black, it
+    /// reflects and transmits nothing (Mitsuba's choice for an emitter without a BSDF). One
+    /// for the scene, added when first asked for.
+    pub fn black_material(&mut self) -> MaterialId {
+        match self.black {
+            Some(id) => id,
+            None => {
+                let id = self.add_material("black", Material::Phong(PhongMaterial::black()));
+                self.black = Some(id);
+                id
+            }
+        }
+    }
+
+    /// The last object added is the surface of the last light added, an area light.
+    fn show_last_light_on_last_object(&mut self) {
+        let light = self.lights.len() as u32 - 1;
+        if let Some(p) = self.primitives.last_mut() {
+            p.light = Some(light);
+        }
     }
 
     pub fn add_material(
@@ -122,6 +143,7 @@ impl SceneBuilder {
             motion: None,
             material,
             vertex_materials: None,
+            light: None,
         });
         self.object_names.push(name.into());
     }
@@ -191,12 +213,10 @@ impl SceneBuilder {
             }
             Emitter::Triangles { .. } => None,
         };
-        let object = shape.map(|shape| {
-            let material =
-                self.add_material(format!("{name} (emitter)"), Material::emitter(radiance));
-            self.add_object(name.clone(), shape, Transform::IDENTITY, material);
-            (self.primitives.len() - 1) as u32
-        });
+        if let Some(shape) = &shape {
+            let material = self.black_material();
+            self.add_object(name.clone(), shape.clone(), Transform::IDENTITY, material);
+        }
         self.add_light(
             name,
             Light::Area {
@@ -206,15 +226,14 @@ impl SceneBuilder {
                 two_sided: true,
             },
         );
-        if let Some(last) = self.light_objects.last_mut() {
-            *last = object;
+        if shape.is_some() {
+            self.show_last_light_on_last_object();
         }
     }
 
     pub fn add_light(&mut self, name: impl Into<String>, light: Light) {
         self.lights.push(light);
         self.light_names.push(name.into());
-        self.light_objects.push(None);
         self.light_spectra.push(None);
     }
 
@@ -258,9 +277,7 @@ impl SceneBuilder {
         let lights = Lights::new(
             self.lights,
             self.light_names,
-            self.light_objects,
             &self.light_spectra,
-            self.primitives.len(),
             background_light,
         );
         let geometry = Geometry::new(

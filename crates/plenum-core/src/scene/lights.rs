@@ -1,5 +1,6 @@
-//! The scene's lights: each light, its name and its emission as a spectrum, the primitive
-//! that shows an area light, the lights at infinity, and how next-event estimation picks one.
+//! The scene's lights: each light, its name and its emission as a spectrum, the lights at
+//! infinity, and how next-event estimation picks one. An area light's surface is a primitive
+//! that names it ([`super::Primitive::light`]).
 
 use crate::color::Color;
 use crate::light::Light;
@@ -12,12 +13,8 @@ use plenum_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 pub struct Lights {
     all: Vec<Light>,
     pub names: Vec<String>,
-    /// Per light: the primitive that shows it, for area lights.
-    pub objects: Vec<Option<u32>>,
     /// Per light: its emission as a spectrum (an RGB light's uplifted as an illuminant).
     spectra: Vec<SpectrumValue>,
-    /// Per primitive: the area light it is the surface of.
-    of_primitive: Vec<Option<u32>>,
     /// The lights at infinity, which rays that hit nothing see.
     pub infinite: Vec<u32>,
     /// Chooses a light for next-event estimation.
@@ -27,16 +24,14 @@ pub struct Lights {
 }
 
 impl Lights {
-    /// The lights `all`, named by `names`, shown by the primitives `objects` (of
-    /// `primitives`), with a spectrum and scale in place of the RGB value of some
+    /// The lights `all`, named by `names`, with a spectrum and scale in place of the RGB
+    /// value of some
     /// (`spectra`: their RGB value becomes that spectrum's, for Whitted's model and RGB
     /// mode). The light `background` is the background's.
     pub(super) fn new(
         mut all: Vec<Light>,
         names: Vec<String>,
-        objects: Vec<Option<u32>>,
         spectra: &[Option<(Spectrum, f64)>],
-        primitives: usize,
         background: Option<u32>,
     ) -> Lights {
         for (light, spectrum) in all.iter_mut().zip(spectra) {
@@ -53,21 +48,13 @@ impl Lights {
                 None => SpectrumValue::from_rgb(l.rgb(), SpectrumKind::Illuminant),
             })
             .collect();
-        let mut of_primitive = vec![None; primitives];
-        for (i, o) in objects.iter().enumerate() {
-            if let Some(p) = o {
-                of_primitive[*p as usize] = Some(i as u32);
-            }
-        }
         let infinite = (0..all.len() as u32)
             .filter(|&i| all[i as usize].is_infinite())
             .collect();
         Lights {
             all,
             names,
-            objects,
             spectra,
-            of_primitive,
             infinite,
             sampler: LightSampler::default(),
             background,
@@ -96,12 +83,6 @@ impl Lights {
                 LightSampler::new(&powers)
             }
         };
-    }
-
-    /// The area light whose surface the primitive is.
-    #[inline]
-    pub fn of_primitive(&self, primitive: u32) -> Option<u32> {
-        self.of_primitive[primitive as usize]
     }
 
     /// Light `light`'s emission as a spectrum (with its RGB value).

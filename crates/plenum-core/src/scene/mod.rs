@@ -46,6 +46,12 @@ impl Scene {
         self
     }
 
+    /// The area light whose surface `primitive` is.
+    #[inline]
+    pub fn area_light(&self, primitive: u32) -> Option<u32> {
+        self.geometry.primitives[primitive as usize].light
+    }
+
     /// The material of `primitive` (the first of a mesh with per-vertex materials).
     pub fn material_of(&self, primitive: u32) -> &Material {
         &self.materials[self.geometry.primitives[primitive as usize].material as usize]
@@ -105,7 +111,7 @@ impl Scene {
             && primitives.iter().all(|p| {
                 p.vertex_materials.is_none() && {
                     let m = &self.materials[p.material as usize];
-                    m.is_physical() || m.is_emitter_only()
+                    m.is_physical() || m.reflects_nothing()
                 }
             })
     }

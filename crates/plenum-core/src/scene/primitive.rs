@@ -21,6 +21,8 @@ pub struct Primitive {
     /// For meshes: a material per vertex, blended across each triangle by its barycentric
     /// coordinates (the course `.ray` format's per-vertex materials). Replaces `material`.
     pub vertex_materials: Option<Arc<Vec<MaterialId>>>,
+    /// The area light whose surface this is: hits on it see that light's emission.
+    pub light: Option<u32>,
 }
 
 /// Everything the integrator needs about a hit, in world space.

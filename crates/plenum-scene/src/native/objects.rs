@@ -95,10 +95,7 @@ impl<'s> Reader<'s> {
             // Without a material of its own the object only shows its light.
             let material = match f.get("material") {
                 Some(_) => material,
-                None => self.builder.add_material(
-                    format!("{name} (emitter)"),
-                    plenum_core::material::Material::emitter(radiance),
-                ),
+                None => self.builder.black_material(),
             };
             let what = f.required("emission")?.span();
             let added = self.builder.add_emissive_object(
