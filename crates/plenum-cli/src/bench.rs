@@ -368,7 +368,8 @@ fn build_target(accel: BenchAccel, path: &Path) -> Result<(Target, f64), plenum_
         mesh.set_accel(kind);
         Ok((Target::Mesh(Box::new(mesh)), start.elapsed().as_secs_f64()))
     } else {
-        let scene = plenum_scene::load_scene(path)?.scene;
+        // Read with no structures, so that the time is the build of `kind` ones alone.
+        let scene = plenum_scene::load_scene_with(path, AccelKind::None)?.scene;
         let start = Instant::now();
         let scene = scene.with_accel(kind);
         Ok((

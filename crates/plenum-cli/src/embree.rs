@@ -244,7 +244,9 @@ mod tests {
     fn embree_agrees_with_the_bvh_on_the_bunny() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../../shared/data/meshes/stanford-bunny.obj");
-        let mesh = plenum_scene::load_mesh(&path).unwrap();
+        let mesh = plenum_scene::load_mesh(&path)
+            .unwrap()
+            .with_accel(plenum_core::accel::AccelKind::Bvh);
         let embree = EmbreeMesh::build(&mesh, 2).unwrap();
         let (centre, radius) = mesh.bounds().bounding_sphere();
         let mut rng = Rng::new(0x5EED0004, 0);

@@ -19,7 +19,7 @@ use plenum_core::render::{
     new_film, render_film, Adaptive, RenderControl, RenderSettings, MAX_SUBDIVISION,
 };
 use plenum_core::sampling::{Filter, FilterKind, PixelSampler, SamplerKind, MAX_SPP};
-use plenum_scene::{builtin_scene, load_scene, LoadedScene};
+use plenum_scene::{builtin_scene_with, load_scene_with, LoadedScene};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -447,13 +447,14 @@ fn main() -> ExitCode {
     }
 }
 
-/// Loads the scene, or prints its error; `None` means the built-in scene.
-fn load(path: Option<&Path>) -> Result<LoadedScene, ExitCode> {
+/// Loads the scene with `accel` structures, or prints its error; `None` means the built-in
+/// scene.
+fn load(path: Option<&Path>, accel: AccelKind) -> Result<LoadedScene, ExitCode> {
     match path {
-        None => Ok(builtin_scene()),
-        Some(p) if p.as_os_str() == "-" => Ok(builtin_scene()),
+        None => Ok(builtin_scene_with(accel)),
+        Some(p) if p.as_os_str() == "-" => Ok(builtin_scene_with(accel)),
         Some(p) => {
-            let loaded = load_scene(p).map_err(|e| {
+            let loaded = load_scene_with(p, accel).map_err(|e| {
                 eprintln!("{e}");
                 ExitCode::from(2)
             })?;
@@ -708,7 +709,7 @@ fn convert(args: ConvertArgs) -> ExitCode {
         );
         return ExitCode::from(2);
     }
-    let loaded = match load(Some(&args.input)) {
+    let loaded = match load(Some(&args.input), AccelKind::None) {
         Ok(l) => l,
         Err(code) => return code,
     };
@@ -824,27 +825,15 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
         resumed = Some((path, film, provenance));
     }
     let load_start = Instant::now();
-    let mut loaded = match load(args.scene.as_deref()) {
+    let mut loaded = match load(args.scene.as_deref(), args.accel) {
         Ok(l) => l,
         Err(code) => return code,
     };
-    if args.accel != AccelKind::Bvh {
-        let LoadedScene {
-            scene,
-            defaults,
-            warnings,
-        } = loaded;
-        loaded = LoadedScene {
-            scene: scene.with_accel(args.accel),
-            defaults,
-            warnings,
-        };
-        for what in loaded.scene.geometry.capped_structures() {
-            eprintln!(
-                "warning: the {} over {what} reached its memory bound (items that overlap many cells); it is kept coarser there, and slower",
-                args.accel
-            );
-        }
+    for what in loaded.scene.geometry.capped_structures() {
+        eprintln!(
+            "warning: the {} over {what} reached its memory bound (items that overlap many cells); it is kept coarser there, and slower",
+            args.accel
+        );
     }
     let load_seconds = load_start.elapsed().as_secs_f64();
     let mut settings = match settings(&args.view, &mut loaded) {

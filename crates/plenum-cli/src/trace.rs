@@ -1,6 +1,7 @@
 //! `plenum trace-pixel`: the ray tree of one pixel, as text or JSON.
 
 use crate::{load, settings, TracePixelArgs};
+use plenum_core::accel::AccelKind;
 use plenum_core::integrator::{RayNode, RayTree};
 use plenum_core::render::trace_pixel;
 use plenum_core::{Color, Vec3};
@@ -10,7 +11,7 @@ use std::io::Write as _;
 use std::process::ExitCode;
 
 pub fn run(args: TracePixelArgs) -> ExitCode {
-    let mut loaded = match load(Some(&args.scene)) {
+    let mut loaded = match load(Some(&args.scene), AccelKind::Bvh) {
         Ok(l) => l,
         Err(code) => return code,
     };

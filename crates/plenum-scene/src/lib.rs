@@ -21,6 +21,7 @@ mod writer;
 pub use writer::to_toml;
 
 pub use diagnostics::SceneError;
+use plenum_core::accel::AccelKind;
 use plenum_core::scene::Scene;
 use std::path::Path;
 
@@ -86,7 +87,8 @@ pub struct LoadedScene {
 }
 
 /// Reads a mesh file (`.obj` or `.ply`) as one mesh, triangles in file order (polygons
-/// fanned from their first vertex), as the shared benchmark files number them.
+/// fanned from their first vertex), as the shared benchmark files number them; in no
+/// structure yet ([`plenum_core::geometry::TriangleMesh::set_accel`] builds one).
 pub fn load_mesh(path: &Path) -> Result<plenum_core::geometry::TriangleMesh, SceneError> {
     let extension = path
         .extension()
@@ -117,8 +119,14 @@ pub const SCENE_EXTENSIONS: [&str; 9] = [
 /// (Haines' Neutral File Format), `.ray` (the course ray tracer's format), `.obj` and `.ply`
 /// (a mesh, framed by a default camera and lights), `.xml` (Mitsuba 3), `.gltf` and `.glb`
 /// (glTF 2.0), `.pbrt` (pbrt-v4); any other is refused. Relative paths
-/// inside are resolved against the file's folder.
+/// inside are resolved against the file's folder. The scene's structures are BVHs.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
+    load_scene_with(path, AccelKind::Bvh)
+}
+
+/// [`load_scene`] with `accel` structures over the primitives and inside every mesh, each
+/// built once.
+pub fn load_scene_with(path: &Path, accel: AccelKind) -> Result<LoadedScene, SceneError> {
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
@@ -137,69 +145,55 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
     }
     let bytes = std::fs::read(path)
         .map_err(|e| SceneError::file(path, format!("cannot read the scene file: {e}")))?;
-    read_scene(path, &extension, bytes)
+    read_scene_with(path, &extension, bytes, accel)
 }
 
 /// [`load_scene`] of a file's bytes already read: `extension` (lower case) chooses the reader,
 /// `path` names the file in messages and resolves relative paths inside. The fuzz targets
 /// call it.
 pub fn read_scene(path: &Path, extension: &str, bytes: Vec<u8>) -> Result<LoadedScene, SceneError> {
-    if extension == "gltf" || extension == "glb" {
-        let (builder, defaults, warnings) = gltf::parse(path, &bytes)?;
-        return Ok(LoadedScene {
-            scene: builder.build(),
-            defaults,
-            warnings,
-        });
-    }
-    if extension == "obj" || extension == "ply" {
+    read_scene_with(path, extension, bytes, AccelKind::Bvh)
+}
+
+/// [`read_scene`] with `accel` structures, as [`load_scene_with`].
+pub fn read_scene_with(
+    path: &Path,
+    extension: &str,
+    bytes: Vec<u8>,
+    accel: AccelKind,
+) -> Result<LoadedScene, SceneError> {
+    let (builder, defaults, mut warnings) = match extension {
+        "gltf" | "glb" => gltf::parse(path, &bytes)?,
         // PLY is binary, and OBJ is read leniently by the model's reader.
-        return model::model_from_bytes(path, extension, bytes);
-    }
-    let (text, not_utf8) = text::lenient(path, bytes);
-    let base = path.parent().unwrap_or(Path::new("."));
-    let mut loaded = match extension {
-        "nff" => {
-            let (builder, defaults) = nff::parse(path, &text)?;
-            LoadedScene {
-                scene: builder.build(),
-                defaults,
-                warnings: Vec::new(),
-            }
+        "obj" | "ply" => model::model_from_bytes(path, extension, bytes)?,
+        _ => {
+            let (text, not_utf8) = text::lenient(path, bytes);
+            let base = path.parent().unwrap_or(Path::new("."));
+            let (builder, defaults, mut warnings) = match extension {
+                "nff" => {
+                    let (builder, defaults) = nff::parse(path, &text)?;
+                    (builder, defaults, Vec::new())
+                }
+                "pbrt" => pbrt::parse(path, text)?,
+                "xml" => mitsuba::parse(path, text)?,
+                "ray" => ray::parse(path, &text, base)?,
+                _ => native::parse(path, &text, base)?,
+            };
+            warnings.splice(0..0, not_utf8);
+            (builder, defaults, warnings)
         }
-        "pbrt" => {
-            let (builder, defaults, warnings) = pbrt::parse(path, text)?;
-            LoadedScene {
-                scene: builder.build(),
-                defaults,
-                warnings,
-            }
-        }
-        "xml" => {
-            let (builder, defaults, warnings) = mitsuba::parse(path, text)?;
-            LoadedScene {
-                scene: builder.build(),
-                defaults,
-                warnings,
-            }
-        }
-        "ray" => {
-            let (builder, defaults, warnings) = ray::parse(path, &text, base)?;
-            LoadedScene {
-                scene: builder.build(),
-                defaults,
-                warnings,
-            }
-        }
-        _ => parse_scene(path, &text, base)?,
     };
-    loaded.warnings.splice(0..0, not_utf8);
-    if loaded.scene.emits_nothing() {
-        loaded.warnings.push(
+    let scene = builder.build_with(accel);
+    if scene.emits_nothing() {
+        warnings.push(
             SceneError::file(path, "the scene has no light: no light source, no emitting surface, a black background and no ambient light, so the image will be black").as_warning(),
         );
     }
-    Ok(loaded)
+    Ok(LoadedScene {
+        scene,
+        defaults,
+        warnings,
+    })
 }
 
 /// An MTL material library's bytes, read as an OBJ's `mtllib` is; the number of materials.
@@ -226,10 +220,20 @@ pub const BUILTIN_SCENE: &str = include_str!("../../../scenes/whitted.toml");
 /// Whitted's 1980 picture: a checkerboard floor, a glass sphere and a mirror sphere under
 /// two point lights.
 pub fn builtin_scene() -> LoadedScene {
-    parse_scene(
+    builtin_scene_with(AccelKind::Bvh)
+}
+
+/// [`builtin_scene`] with `accel` structures.
+pub fn builtin_scene_with(accel: AccelKind) -> LoadedScene {
+    let (builder, defaults, warnings) = native::parse(
         Path::new("<built-in whitted.toml>"),
         BUILTIN_SCENE,
         Path::new("."),
     )
-    .expect("the built-in scene is valid")
+    .expect("the built-in scene is valid");
+    LoadedScene {
+        scene: builder.build_with(accel),
+        defaults,
+        warnings,
+    }
 }

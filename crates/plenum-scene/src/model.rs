@@ -2,7 +2,7 @@
 //! lit by default lights so it can be seen at once. OBJ files keep their MTL materials.
 
 use crate::diagnostics::SceneError;
-use crate::{mtl, obj, ply, LoadedScene, RenderDefaults};
+use crate::{mtl, obj, ply, RenderDefaults};
 use plenum_core::camera::CameraSettings;
 use plenum_core::color::Color;
 use plenum_core::geometry::{Shape, TriangleMesh};
@@ -23,7 +23,7 @@ pub fn model_from_bytes(
     path: &Path,
     extension: &str,
     bytes: Vec<u8>,
-) -> Result<LoadedScene, SceneError> {
+) -> Result<(SceneBuilder, RenderDefaults, Vec<String>), SceneError> {
     let base = path.parent().unwrap_or(Path::new("."));
     let mut warnings = Vec::new();
     let groups: Vec<(String, PhongMaterial, TriangleMesh)> = if extension == "ply" {
@@ -98,11 +98,7 @@ pub fn model_from_bytes(
             },
         );
     }
-    Ok(LoadedScene {
-        scene: builder.build(),
-        defaults: RenderDefaults::default(),
-        warnings,
-    })
+    Ok((builder, RenderDefaults::default(), warnings))
 }
 
 fn default_material() -> PhongMaterial {

@@ -90,3 +90,40 @@ fn breakfast_room_ply_meshes_load() {
     let first = load_scene(&files[1]).unwrap();
     assert!(renders_something(&first));
 }
+
+/// A scene is read with the structures its render asks for, each built once: the scene's
+/// and every mesh's are of that kind, and instances of one mesh still share it.
+#[test]
+fn scenes_are_read_with_the_structures_asked_for() {
+    use plenum_core::accel::AccelKind;
+    use std::sync::Arc;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/instances.toml");
+    for kind in [
+        AccelKind::Bvh,
+        AccelKind::Grid,
+        AccelKind::Octree,
+        AccelKind::None,
+    ] {
+        let scene = plenum_scene::load_scene_with(&path, kind)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .scene;
+        assert_eq!(scene.geometry.accel_kind(), kind);
+        let meshes: Vec<_> = scene
+            .geometry
+            .primitives
+            .iter()
+            .filter_map(|p| match &p.shape {
+                Shape::Mesh(m) => Some(m.clone()),
+                _ => None,
+            })
+            .collect();
+        assert!(
+            meshes.len() > 1,
+            "{kind}: the scene places its gem more than once"
+        );
+        for m in &meshes {
+            assert_eq!(m.accel_kind(), kind);
+            assert!(Arc::ptr_eq(m, &meshes[0]), "{kind}: an instance was copied");
+        }
+    }
+}

@@ -135,6 +135,9 @@ impl std::fmt::Display for MeshError {
 
 impl TriangleMesh {
     /// A mesh of `triangles` over `positions`, with per-vertex `normals` and `uvs` or none.
+    /// Its triangles are in no structure yet (`AccelKind::None`, tested one by one): a
+    /// scene gives each mesh the structure its render asks for when it is built, so no
+    /// structure is built twice. Outside a scene, [`TriangleMesh::set_accel`] builds one.
     pub fn new(
         positions: Vec<Vec3>,
         triangles: Vec<[u32; 3]>,
@@ -216,7 +219,7 @@ impl TriangleMesh {
             closed,
         };
         let indices = if keep_indices { triangles } else { Vec::new() };
-        mesh.store(&corners, &indices, AccelKind::Bvh, EMBED_LIMIT);
+        mesh.store(&corners, &indices, AccelKind::None, EMBED_LIMIT);
         Ok(mesh)
     }
 

@@ -113,8 +113,13 @@ fn leaves_the_build_cannot_split_by_position_still_take_one_test() {
         triangles.push([first, first + 1, first + 2]);
     }
     let mesh = TriangleMesh::new(positions, triangles, vec![], vec![]).unwrap();
+    assert!(
+        matches!(&mesh.accel, Accel::None(_)),
+        "a new mesh is in no structure yet"
+    );
+    let mesh = mesh.with_accel(AccelKind::Bvh);
     let Accel::Bvh(bvh) = &mesh.accel else {
-        panic!("the BVH is the default")
+        panic!("a BVH was asked for")
     };
     assert!(bvh.is_embedded());
     let leaves = bvh.embedded_leaves();
@@ -179,7 +184,9 @@ fn a_bvh_with_its_blocks_apart_finds_the_hits_of_one_with_them_among_its_nodes()
     // no bytes. Rays from above at random (seed 12).
     let (positions, triangles) = sheet(24);
     let normals = vec![Vec3::Z; positions.len()];
-    let among = TriangleMesh::new(positions, triangles.clone(), normals, vec![]).unwrap();
+    let among = TriangleMesh::new(positions, triangles.clone(), normals, vec![])
+        .unwrap()
+        .with_accel(AccelKind::Bvh);
     let apart = among.rebuilt(AccelKind::Bvh, 0);
     assert!(matches!(&among.accel, Accel::Bvh(b) if b.is_embedded()));
     assert!(matches!(&apart.accel, Accel::Bvh(b) if !b.is_embedded()));
@@ -363,7 +370,9 @@ fn large_triangles_kept_out_of_cells_are_still_hit() {
 fn a_bvh_mesh_takes_at_most_64_bytes_a_triangle() {
     // The budget of the acceleration issue, vertices, indices and nodes included.
     let (positions, triangles) = sheet(100);
-    let mesh = TriangleMesh::new(positions, triangles, vec![], vec![]).unwrap();
+    let mesh = TriangleMesh::new(positions, triangles, vec![], vec![])
+        .unwrap()
+        .with_accel(AccelKind::Bvh);
     let per_triangle = mesh.memory_bytes() as f64 / mesh.triangle_count() as f64;
     assert!(per_triangle <= 64.0, "{per_triangle} bytes a triangle");
 }
