@@ -4,7 +4,7 @@
 use crate::camera::CameraSettings;
 use crate::color::Color;
 use crate::geometry::{Polygon, Shape, Sphere};
-use crate::light::Emitter;
+use crate::light::{Attenuation, Emitter, Light};
 use crate::material::{
     ConductorMaterial, ConductorSpec, DiffuseMaterial, FloatTexture, Material, MaterialId,
     Roughness, SpectralTexture, SpectrumKind,
@@ -155,4 +155,81 @@ pub fn furnace(albedo: f64, radiance: f64) -> Scene {
         1,
     );
     b.build()
+}
+
+/// A diffuse floor (the plane y = 0, 40 wide, reflectance `albedo`) under a lamp 1 above the
+/// origin: a disk of radius 1 and radiance 1 facing down, or (`point`) a point light of
+/// intensity 1. The camera, at (0, 0.8, 3) with a 20° field, sees the floor and nothing
+/// else; [`lamp_over_floor_radiance`] is what it sees.
+pub fn lamp_over_floor(albedo: f64, point: bool) -> Scene {
+    let mut b = SceneBuilder::default();
+    b.camera = CameraSettings {
+        position: Vec3::new(0.0, 0.8, 3.0),
+        look_at: Vec3::ZERO,
+        fov_degrees: 20.0,
+        ..CameraSettings::default()
+    };
+    let floor = b.add_material("floor", diffuse(Color::gray(albedo)));
+    let corners = [(-20.0, 20.0), (20.0, 20.0), (20.0, -20.0), (-20.0, -20.0)]
+        .map(|(x, z)| Vec3::new(x, 0.0, z));
+    quad(&mut b, "floor", corners, floor);
+    let at = Vec3::new(0.0, 1.0, 0.0);
+    if point {
+        let intensity = Color::WHITE;
+        let attenuation = Attenuation::default();
+        b.add_light(
+            "lamp",
+            Light::Point {
+                position: at,
+                intensity,
+                attenuation,
+            },
+        );
+    } else {
+        let disk = Emitter::Disk {
+            center: at,
+            normal: -Vec3::Y,
+            radius: 1.0,
+        };
+        b.add_area_light("lamp", disk, Color::WHITE, 1);
+    }
+    b.build()
+}
+
+/// The radiance the floor of [`lamp_over_floor`] sends toward any direction from `p` on it:
+/// ρ/π·E, with E = I h/(r² + h²)^{3/2} under the point light at height h (r the distance
+/// from the point below it) and, under the disk of radius a,
+/// E = (π L/2)·(1 − (h² + r² − a²)/√((h² + r² + a²)² − 4 a² r²)) (the view factor of a
+/// coaxial parallel disk).
+pub fn lamp_over_floor_radiance(albedo: f64, point: bool, p: Vec3) -> f64 {
+    let (h, a) = (1.0f64, 1.0f64);
+    let r2 = p.x * p.x + p.z * p.z;
+    let e = if point {
+        h / (r2 + h * h).powf(1.5)
+    } else {
+        let s = h * h + r2 + a * a;
+        std::f64::consts::FRAC_PI_2
+            * (1.0 - (h * h + r2 - a * a) / (s * s - 4.0 * a * a * r2).sqrt())
+    };
+    albedo * std::f64::consts::FRAC_1_PI * e
+}
+
+/// The mean over a `size`² image of [`lamp_over_floor`] of [`lamp_over_floor_radiance`],
+/// each pixel the mean of 4 × 4 points of it.
+pub fn lamp_over_floor_image_mean(albedo: f64, point: bool, size: u32) -> f64 {
+    let scene = lamp_over_floor(albedo, point);
+    let camera = crate::camera::Camera::new(&scene.camera, size, size);
+    let mut sum = 0.0;
+    for (x, y) in (0..size * size).map(|i| (i % size, i / size)) {
+        for k in 0..16 {
+            let (dx, dy) = ((k % 4) as f64 / 4.0 + 0.125, (k / 4) as f64 / 4.0 + 0.125);
+            let ray = camera.sample_ray(x as f64 + dx, y as f64 + dy, [0.5; 2], 0.0);
+            let (_, hit) = scene
+                .geometry
+                .intersect(&ray, f64::INFINITY)
+                .expect("the floor");
+            sum += lamp_over_floor_radiance(albedo, point, ray.at(hit.t));
+        }
+    }
+    sum / (16 * size * size) as f64
 }

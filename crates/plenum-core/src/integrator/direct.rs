@@ -210,3 +210,69 @@ pub(super) fn bsdf_sample_ld(
         None => SampledSpectrum::ZERO,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kit;
+    use crate::sampling::Rng;
+    use plenum_spectrum::ColorMode;
+
+    /// Direct light under a disk lamp against its closed form (the view factor of a
+    /// parallel disk): light sampling alone, and light sampling with one BSDF sample, each
+    /// weighed by the power heuristic, at three points of the floor (near the lamp's centre,
+    /// under its rim, beyond it). 20,000 samples each, seed 3: within 1.5 % (measured
+    /// within 0.5 %). Weights that did not sum to one would be off by far more: counting both
+    /// strategies in full doubles the light where the BSDF samples find the lamp.
+    #[test]
+    fn direct_light_under_a_disk_lamp_matches_its_closed_form() {
+        let scene = kit::lamp_over_floor(0.5, false);
+        let mut counts = RayCounts::default();
+        for x in [0.0, 1.0, 2.5] {
+            let ray = Ray::new(Vec3::new(x, 0.5, 0.3), -Vec3::Y);
+            let (prim, hit) = scene.geometry.intersect(&ray, f64::INFINITY).unwrap();
+            let it = scene.geometry.interaction(&ray, prim, &hit);
+            let expected = kit::lamp_over_floor_radiance(0.5, false, it.p);
+            let wo = Vec3::Y;
+            for bsdf_samples in [0.0, 1.0] {
+                let n = 20_000;
+                let mut sum = 0.0;
+                for i in 0..n {
+                    let mut stream = SampleStream::random(Rng::new(3, i));
+                    let mut wl = super::super::sample_wavelengths(ColorMode::Rgb, &mut stream);
+                    let bsdf = scene.bsdf(&it, wo, &mut wl).expect("a diffuse floor");
+                    let mut l = sample_ld(
+                        &scene,
+                        &it,
+                        wo,
+                        &bsdf,
+                        &wl,
+                        &mut stream,
+                        &mut counts,
+                        0.0,
+                        bsdf_samples,
+                    );
+                    if bsdf_samples > 0.0 {
+                        l += bsdf_sample_ld(
+                            &scene,
+                            &it,
+                            wo,
+                            &bsdf,
+                            &wl,
+                            &mut stream,
+                            &mut counts,
+                            0.0,
+                            Lobes::All,
+                        );
+                    }
+                    sum += super::super::rgb(l, &wl).g;
+                }
+                let mean = sum / n as f64;
+                assert!(
+                    (mean / expected - 1.0).abs() < 0.015,
+                    "x = {x}, {bsdf_samples} BSDF samples: {mean:.5}, expected {expected:.5}"
+                );
+            }
+        }
+    }
+}
