@@ -290,7 +290,6 @@ mod tests {
     fn every_method_counts_emission_and_depth_alike_in_a_furnace() {
         const SIZE: u32 = 8;
         let scene = kit::furnace(0.5, 1.0);
-        let camera = Camera::new(&scene.camera, SIZE, SIZE);
         for depth in [0, 1, 3] {
             let expected: f64 = (0..=depth + 1).map(|k| 0.5f64.powi(k as i32)).sum();
             for (kind, spp, tolerance) in [
@@ -312,22 +311,7 @@ mod tests {
                     },
                     ..IntegratorConfig::default()
                 };
-                let splats = SplatBuffer::new(SIZE, SIZE, 1.0 / spp as f64);
-                let integrator = Integrator::new(&scene, &config, &camera, &splats, None, 5);
-                let mut film = Film::new(SIZE, SIZE);
-                let mut counts = RayCounts::default();
-                for (x, y) in (0..SIZE * SIZE).map(|i| (i % SIZE, i / SIZE)) {
-                    for i in 0..spp {
-                        let mut stream = SampleStream::random(Rng::for_sample(5, x, y, i));
-                        let (dx, dy) = (stream.next_1d(), stream.next_1d());
-                        let ray = camera.sample_ray(x as f64 + dx, y as f64 + dy, [0.5; 2], 0.0);
-                        let c = integrator.camera_ray(&ray, &mut stream, &mut counts, None);
-                        film.add_sample(x, y, c, 1.0);
-                    }
-                }
-                film.add_splats(&splats);
-                film.resolve(1.0);
-                let mean = green_mean(&film);
+                let mean = test_image_mean(&scene, &config, SIZE, spp, 5);
                 assert!(
                     (mean / expected - 1.0).abs() < tolerance,
                     "{}, max_depth {depth}: {mean:.4}, expected {expected:.4}",
