@@ -25,9 +25,8 @@ pub struct Lights {
 
 impl Lights {
     /// The lights `all`, named by `names`, with a spectrum and scale in place of the RGB
-    /// value of some
-    /// (`spectra`: their RGB value becomes that spectrum's, for Whitted's model and RGB
-    /// mode). The light `background` is the background's.
+    /// value of some (`spectra`: their RGB value becomes that spectrum's, for Whitted's
+    /// model and RGB mode). The light `background` is the background's.
     pub(super) fn new(
         mut all: Vec<Light>,
         names: Vec<String>,
