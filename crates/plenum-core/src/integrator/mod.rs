@@ -9,6 +9,7 @@
 
 mod bdpt;
 mod direct;
+mod eye_path;
 mod light_path;
 mod light_tracing;
 mod medium;

@@ -12,12 +12,9 @@
 //! [`RayCounts::invalid`] and left out of the film.
 
 use super::direct::Lobes;
-use super::{
-    direct, record, record_hit, IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Stop,
-};
-use crate::bxdf::TransportMode;
-use crate::color::Color;
-use crate::math::{offset_ray_origin, Ray};
+use super::eye_path::EyePath;
+use super::{direct, record, rgb, IntegratorConfig, RayCounts, RayTree, Stop};
+use crate::math::Ray;
 use crate::sampling::SampleStream;
 use crate::scene::Scene;
 use plenum_spectrum::{ColorMode, SampledSpectrum, SampledWavelengths};
@@ -51,92 +48,39 @@ impl<'a> PathTracer<'a> {
     ) -> SampledSpectrum {
         let scene = self.scene;
         let mut l = SampledSpectrum::ZERO;
-        let mut beta = SampledSpectrum::ONE;
-        // For MIS on an emitter the path hits: the BSDF pdf of the direction it left by,
-        // and the point it left from. The camera ray and specular bounces find emitters that
-        // light sampling cannot: their infinite pdf takes the emission in full.
-        let mut pdf_bsdf = f64::INFINITY;
-        let mut previous = camera_ray.origin;
+        let mut path = EyePath::new(camera_ray);
         // The product of η² over transmissions, which radiance scaling has divided out of
-        // beta but which must not drive Russian roulette (pbrt-v4's `etaScale`).
+        // the throughput but which must not drive Russian roulette (pbrt-v4's `etaScale`).
         let mut eta_scale = 1.0;
-        let mut ray = *camera_ray;
-        let mut kind = RayKind::Camera;
-        let mut parent = None;
-        let mut depth = 0u32;
         loop {
-            let node = tree.as_deref_mut().map(|t| {
-                t.push(RayNode::new(
-                    parent,
-                    kind,
-                    depth,
-                    ray.origin,
-                    ray.direction,
-                    Color::from(beta.0),
-                ))
-            });
-            let Some((prim, hit)) = scene.geometry.intersect(&ray, f64::INFINITY) else {
-                let d = ray.direction.normalized();
-                let le = direct::infinite_mis(scene, d, wl, pdf_bsdf, 1.0);
-                l += beta * le;
-                record(&mut tree, node, |n| {
-                    n.stops.push(Stop::Miss);
-                    let [r, g, b] = (beta * le).to_linear_srgb(wl);
-                    n.color = Color::new(r, g, b);
-                });
+            // The ray tree shows what each vertex adds to the pixel, in linear sRGB.
+            let before = l;
+            let added = |l: SampledSpectrum, wl: &SampledWavelengths| rgb(l - before, wl);
+            let Some(v) = path.trace(scene, wl, &mut l, &mut tree) else {
                 break;
             };
-            let it = scene.geometry.interaction(&ray, prim, &hit);
-            let wo = -ray.direction.normalized();
-            record_hit(&mut tree, node, scene, prim, hit.t * ray.direction.length());
-
-            // Light the path finds on its own, weighed against light sampling's chance of
-            // having found it.
-            let before = l;
-            if let Some(light) = scene.area_light(prim) {
-                let le = direct::emitted_mis(scene, light, &it, wo, wl, pdf_bsdf, previous, 1.0);
-                l += beta * le;
-            } else if let Some(ke) = scene.phong_emission(&it, wl) {
-                // A Phong surface's k_e: seen, but no light to sample.
-                l += beta * ke;
-            }
-            // The ray tree shows what each vertex adds to the pixel, in linear sRGB.
-            let added = |l: SampledSpectrum, wl: &SampledWavelengths| {
-                let [r, g, b] = (l - before).to_linear_srgb(wl);
-                Color::new(r, g, b)
-            };
-
-            let Some(bsdf) = scene.bsdf(&it, wo, wl) else {
+            let (it, wo, node) = (&v.it, v.wo, v.node);
+            let beta = path.beta;
+            let time = path.ray.time;
+            let Some(bsdf) = scene.bsdf(it, wo, wl) else {
                 record(&mut tree, node, |n| {
                     n.stops.push(Stop::Opaque);
                     n.color = added(l, wl);
                 });
                 break;
             };
-            let flags = bsdf.flags();
-            if flags.is_non_specular() {
+            if bsdf.flags().is_non_specular() {
                 // Weighed against the BSDF-sampled ray, the next bounce's or, at the last
                 // vertex, one traced for its light alone.
-                let ld =
-                    direct::sample_ld(scene, &it, wo, &bsdf, wl, stream, counts, ray.time, 1.0);
-                l += beta * ld;
+                l += beta * direct::sample_ld(scene, it, wo, &bsdf, wl, stream, counts, time, 1.0);
             }
-            if depth >= self.max_depth {
+            if path.depth >= self.max_depth {
                 // The last vertex still takes the light its BSDF-sampled ray meets (an
                 // emitter, the sky, light seen in a mirror), but the path ends here (as
                 // pbrt-v4's and Mitsuba's path tracers count depth).
+                let lobes = Lobes::All;
                 l += beta
-                    * direct::bsdf_sample_ld(
-                        scene,
-                        &it,
-                        wo,
-                        &bsdf,
-                        wl,
-                        stream,
-                        counts,
-                        ray.time,
-                        Lobes::All,
-                    );
+                    * direct::bsdf_sample_ld(scene, it, wo, &bsdf, wl, stream, counts, time, lobes);
                 record(&mut tree, node, |n| {
                     n.color = added(l, wl);
                     n.stops.push(Stop::Depth);
@@ -144,44 +88,21 @@ impl<'a> PathTracer<'a> {
                 break;
             }
             record(&mut tree, node, |n| n.color = added(l, wl));
-
-            let uc = stream.next_1d();
-            let u = stream.next_2d();
-            let Some(bs) = bsdf.sample_f(wo, uc, u, TransportMode::Radiance) else {
-                record(&mut tree, node, |n| n.stops.push(Stop::Opaque));
+            let (uc, u) = (stream.next_1d(), stream.next_2d());
+            let Some(bs) = path.bounce(&v, &bsdf, uc, u, counts, &mut tree) else {
                 break;
-            };
-            let cos = bs.wi.dot(it.shading_n).abs();
-            beta *= bs.f * (cos / bs.pdf);
-            pdf_bsdf = match bs.is_specular() {
-                true => f64::INFINITY,
-                false => direct::bsdf_pdf(&bsdf, wo, &bs),
             };
             if bs.is_transmission() {
                 eta_scale *= bs.eta * bs.eta;
-                counts.refraction += 1;
-                kind = RayKind::Refracted;
-            } else {
-                counts.reflection += 1;
-                kind = RayKind::Reflected;
             }
-            if beta.is_black() {
-                break;
-            }
-            previous = it.p;
-            let origin = offset_ray_origin(it.p, it.p_error, it.n, bs.wi);
-            ray = Ray::new(origin, bs.wi).at_time(ray.time);
-            parent = node;
-            depth += 1;
-
             // Russian roulette on the throughput with radiance scaling put back.
-            let rr = (beta * eta_scale).max_value();
-            if depth > self.rr_depth && rr < 1.0 {
+            let rr = (path.beta * eta_scale).max_value();
+            if path.depth > self.rr_depth && rr < 1.0 {
                 let q = (1.0 - rr).max(0.0);
                 if stream.next_1d() < q {
                     break;
                 }
-                beta /= 1.0 - q;
+                path.beta /= 1.0 - q;
             }
         }
         l

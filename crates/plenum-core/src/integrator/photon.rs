@@ -35,6 +35,7 @@
 //! the caustic map's caustics; docs/photon-mapping.md gives the measured values.
 
 use super::direct::{self, sample_ld};
+use super::eye_path::EyePath;
 use super::photon_map::{Nearest, Photon, PhotonMap, Query};
 use super::photons::{emitted, escaped, shading_correction, PhotonTracer};
 use super::{
@@ -124,53 +125,22 @@ impl<'a> PhotonMapper<'a> {
     ) -> SampledSpectrum {
         let scene = self.scene;
         let mut l = SampledSpectrum::ZERO;
-        let mut beta = SampledSpectrum::ONE;
-        let mut ray = *camera_ray;
-        let mut kind = RayKind::Camera;
-        let mut parent = None;
-        // For MIS on light the path finds after a traced glossy bounce, as in the path
-        // tracer; the camera ray and specular bounces take what they find in full.
-        let mut pdf_bsdf = f64::INFINITY;
-        let mut previous = ray.origin;
-        // e: the eye vertex, 1 for the camera ray's hit.
-        for e in 1..=self.max_depth + 1 {
-            let node = tree.as_deref_mut().map(|t| {
-                t.push(RayNode::new(
-                    parent,
-                    kind,
-                    e - 1,
-                    ray.origin,
-                    ray.direction,
-                    rgb(beta, wl),
-                ))
-            });
-            parent = node;
-            let Some((prim, hit)) = scene.geometry.intersect(&ray, f64::INFINITY) else {
-                let d = ray.direction.normalized();
-                l += beta * direct::infinite_mis(scene, d, wl, pdf_bsdf, 1.0);
+        let mut path = EyePath::new(camera_ray);
+        while let Some(v) = path.trace(scene, wl, &mut l, &mut tree) {
+            let (it, wo, node) = (&v.it, v.wo, v.node);
+            let Some(bsdf) = scene.bsdf(it, wo, wl) else {
                 break;
             };
-            let it = scene.geometry.interaction(&ray, prim, &hit);
-            let wo = -ray.direction.normalized();
-            record_hit(&mut tree, node, scene, prim, hit.t * ray.direction.length());
-            if let Some(light) = scene.area_light(prim) {
-                l += beta * direct::emitted_mis(scene, light, &it, wo, wl, pdf_bsdf, previous, 1.0);
-            } else if let Some(ke) = scene.phong_emission(&it, wl) {
-                l += beta * ke;
-            }
-            let Some(bsdf) = scene.bsdf(&it, wo, wl) else {
-                break;
-            };
-            let time = ray.time;
-            let last = e == self.max_depth + 1;
+            let (beta, time) = (path.beta, path.ray.time);
+            // e: the eye vertex, 1 for the camera ray's hit.
+            let e = path.depth + 1;
+            let last = path.depth == self.max_depth;
             if last && bsdf.flags().is_specular() {
                 // The light a last vertex's specular lobes show (a lamp or the sky in a
                 // mirror), which the path tracer's last vertex also takes.
                 let lobes = direct::Lobes::Specular;
                 l += beta
-                    * direct::bsdf_sample_ld(
-                        scene, &it, wo, &bsdf, wl, stream, counts, time, lobes,
-                    );
+                    * direct::bsdf_sample_ld(scene, it, wo, &bsdf, wl, stream, counts, time, lobes);
             }
             // The diffuse part is gathered here, the rest (glossy and specular lobes) traced
             // on, as the path tracer traces it; a last vertex is gathered whole. A sharp
@@ -184,10 +154,9 @@ impl<'a> PhotonMapper<'a> {
             if let Some(g) = gathered {
                 // The gather rays are the BSDF samples MIS weighs the light sample against.
                 let n = if last { 0.0 } else { self.gather_rays as f64 };
-                l += beta * sample_ld(scene, &it, wo, &g, wl, stream, counts, time, n);
+                l += beta * sample_ld(scene, it, wo, &g, wl, stream, counts, time, n);
                 let mut found = (tree.is_some() && !self.caustic.is_empty()).then(Vec::new);
-                let (caustic, r2) =
-                    self.estimate(&self.caustic, &it, wo, &g, wl, e, found.as_mut());
+                let (caustic, r2) = self.estimate(&self.caustic, it, wo, &g, wl, e, found.as_mut());
                 l += beta * caustic;
                 if let Some(photons) = found {
                     record(&mut tree, node, |n| {
@@ -202,7 +171,7 @@ impl<'a> PhotonMapper<'a> {
                 // A smooth coat's own reflection belongs to the traced part.
                 let specular = traced.is_none();
                 let gathered = self.gather(
-                    &it, wo, &g, wl, stream, counts, e, time, specular, &mut tree, node,
+                    it, wo, &g, wl, stream, counts, e, time, specular, &mut tree, node,
                 );
                 l += beta * gathered;
                 record(&mut tree, node, |n| n.color = rgb(l, wl));
@@ -211,33 +180,12 @@ impl<'a> PhotonMapper<'a> {
                 break;
             };
             if r.flags().is_non_specular() {
-                l += beta * sample_ld(scene, &it, wo, &r, wl, stream, counts, time, 1.0);
+                l += beta * sample_ld(scene, it, wo, &r, wl, stream, counts, time, 1.0);
             }
-            let Some(bs) = r.sample_f(
-                wo,
-                stream.next_1d(),
-                stream.next_2d(),
-                TransportMode::Radiance,
-            ) else {
-                break;
-            };
-            beta *= bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
-            pdf_bsdf = match bs.is_specular() {
-                true => f64::INFINITY,
-                false => direct::bsdf_pdf(&r, wo, &bs),
-            };
-            if bs.is_transmission() {
-                counts.refraction += 1;
-                kind = RayKind::Refracted;
-            } else {
-                counts.reflection += 1;
-                kind = RayKind::Reflected;
-            }
-            if beta.is_black() {
+            let (uc, u) = (stream.next_1d(), stream.next_2d());
+            if path.bounce(&v, &r, uc, u, counts, &mut tree).is_none() {
                 break;
             }
-            previous = it.p;
-            ray = Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(time);
         }
         l
     }

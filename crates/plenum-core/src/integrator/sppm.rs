@@ -33,16 +33,14 @@
 //! with some k_d, a smooth coat) gets a visible point or a traced path, chosen at random by
 //! [`crate::bxdf::Bsdf::diffuse_fraction`] and divided by its probability.
 
-use super::direct::{bsdf_pdf, bsdf_sample_ld, emitted_mis, infinite_mis, sample_ld, Lobes};
+use super::direct::{bsdf_sample_ld, sample_ld, Lobes};
+use super::eye_path::EyePath;
 use super::photons::{Arrival, PhotonTracer};
-use super::{
-    record, record_hit, rgb, FoundPhoton, PhotonGather, RayCounts, RayKind, RayNode, RayTree, Stop,
-    WholeImage,
-};
+use super::{rgb, FoundPhoton, PhotonGather, RayCounts, RayTree, WholeImage};
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
 use crate::color::Color;
-use crate::math::{offset_ray_origin, Ray, Vec3};
+use crate::math::Vec3;
 use crate::raw_film::{PhotonStatistics, RawFilm};
 use crate::sampling::Rng;
 use crate::scene::Scene;
@@ -408,56 +406,22 @@ impl Eye<'_> {
         let f = s.filter.sample(stream.pixel());
         let lens = stream.next_2d();
         let shutter = stream.next_1d();
-        let mut ray =
+        let camera_ray =
             self.camera
                 .sample_ray(x as f64 + 0.5 + f.dx, y as f64 + 0.5 + f.dy, lens, shutter);
         counts.camera += 1;
         let mut wl = self.wl;
         let mut l = SampledSpectrum::ZERO;
-        let mut beta = SampledSpectrum::ONE;
-        let mut distance = 0.0;
         let max_depth = s.integrator.max_depth;
-        let (mut kind, mut parent) = (RayKind::Camera, None);
-        // For MIS on light the path finds after a traced (glossy) bounce, as in the path
-        // tracer: the pdf of the direction it left by, and where it left from. The camera
-        // ray and specular bounces take what they find in full.
-        let mut pdf_bsdf = f64::INFINITY;
-        let mut previous = ray.origin;
-        for e in 1..=max_depth + 1 {
-            let node = tree.as_deref_mut().map(|t| {
-                let weight = rgb(beta, &wl);
-                t.push(RayNode::new(
-                    parent,
-                    kind,
-                    e - 1,
-                    ray.origin,
-                    ray.direction,
-                    weight,
-                ))
-            });
-            parent = node;
-            let Some((prim, hit)) = scene.geometry.intersect(&ray, f64::INFINITY) else {
-                let d = ray.direction.normalized();
-                l += beta * infinite_mis(scene, d, &wl, pdf_bsdf, 1.0);
-                record(&mut tree, node, |n| n.stops.push(Stop::Miss));
-                break;
-            };
-            let t = hit.t * ray.direction.length();
-            distance += t;
-            record_hit(&mut tree, node, scene, prim, t);
-            let it = scene.geometry.interaction(&ray, prim, &hit);
-            let wo = -ray.direction.normalized();
-            if let Some(light) = scene.area_light(prim) {
-                l += beta * emitted_mis(scene, light, &it, wo, &wl, pdf_bsdf, previous, 1.0);
-            } else if let Some(ke) = scene.phong_emission(&it, &wl) {
-                l += beta * ke;
-            }
-            let Some(bsdf) = scene.bsdf(&it, wo, &mut wl) else {
+        let mut path = EyePath::new(&camera_ray);
+        while let Some(v) = path.trace(scene, &wl, &mut l, &mut tree) {
+            let (it, wo) = (&v.it, v.wo);
+            let Some(bsdf) = scene.bsdf(it, wo, &mut wl) else {
                 break;
             };
             // The diffuse part gets a visible point, the rest (glossy and specular lobes) is
             // traced on; at the last vertex a diffuse or glossy surface gets one whole.
-            let last = e == max_depth + 1;
+            let last = path.depth == max_depth;
             let (gathered, traced) = if last {
                 (bsdf.flags().is_non_specular().then_some(bsdf), None)
             } else {
@@ -470,38 +434,38 @@ impl Eye<'_> {
                 (Some(g), Some(r)) => {
                     let q = bsdf.diffuse_fraction(wo).clamp(0.1, 0.9);
                     if stream.next_1d() < q {
-                        beta /= q;
+                        path.beta /= q;
                         (Some(g), None)
                     } else {
-                        beta /= 1.0 - q;
+                        path.beta /= 1.0 - q;
                         (None, Some(r))
                     }
                 }
                 parts => parts,
             };
-            let t = ray.time;
+            let (beta, t) = (path.beta, path.ray.time);
             if last {
                 // What the path tracer's last vertex also takes: the light its specular
                 // lobes show (a lamp or the sky in a mirror), which no light sample finds.
                 let lobes = Lobes::Specular;
-                l += beta
-                    * bsdf_sample_ld(scene, &it, wo, &bsdf, &wl, &mut stream, counts, t, lobes);
+                l +=
+                    beta * bsdf_sample_ld(scene, it, wo, &bsdf, &wl, &mut stream, counts, t, lobes);
             }
             if let Some(g) = gathered {
                 // Direct light by MIS of a light sample and one BSDF sample (none at the
                 // last vertex, where a path would not bounce); the traced part's light is
                 // the other estimate's.
                 let n = if last { 0.0 } else { 1.0 };
-                l += beta * sample_ld(scene, &it, wo, &g, &wl, &mut stream, counts, t, n);
+                l += beta * sample_ld(scene, it, wo, &g, &wl, &mut stream, counts, t, n);
                 if !last {
                     let lobes = Lobes::NonSpecular;
-                    let ld = bsdf_sample_ld(scene, &it, wo, &g, &wl, &mut stream, counts, t, lobes);
+                    let ld = bsdf_sample_ld(scene, it, wo, &g, &wl, &mut stream, counts, t, lobes);
                     l += beta * ld;
                 }
                 if px.stats.radius == 0.0 {
                     px.stats.radius = match s.integrator.photon.radius {
                         r if r > 0.0 => r,
-                        _ => FOOTPRINT_PIXELS * self.camera.pixel_footprint(distance),
+                        _ => FOOTPRINT_PIXELS * self.camera.pixel_footprint(path.distance),
                     };
                 }
                 px.vp = Some(VisiblePoint {
@@ -511,7 +475,7 @@ impl Eye<'_> {
                     wo,
                     bsdf: g,
                     beta,
-                    depth: e,
+                    depth: path.depth + 1,
                     wl,
                 });
                 break;
@@ -522,30 +486,12 @@ impl Eye<'_> {
             // The traced part as the path tracer takes it: a light sample weighed by MIS
             // against the BSDF sample that goes on.
             if r.flags().is_non_specular() {
-                l += beta * sample_ld(scene, &it, wo, &r, &wl, &mut stream, counts, t, 1.0);
+                l += beta * sample_ld(scene, it, wo, &r, &wl, &mut stream, counts, t, 1.0);
             }
             let (uc, u) = (stream.next_1d(), stream.next_2d());
-            let Some(bs) = r.sample_f(wo, uc, u, TransportMode::Radiance) else {
-                break;
-            };
-            beta *= bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
-            pdf_bsdf = match bs.is_specular() {
-                true => f64::INFINITY,
-                false => bsdf_pdf(&r, wo, &bs),
-            };
-            if bs.is_transmission() {
-                counts.refraction += 1;
-                kind = RayKind::Refracted;
-            } else {
-                counts.reflection += 1;
-                kind = RayKind::Reflected;
-            }
-            if beta.is_black() {
+            if path.bounce(&v, &r, uc, u, counts, &mut tree).is_none() {
                 break;
             }
-            previous = it.p;
-            ray =
-                Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(ray.time);
         }
         let c = rgb(l, &wl);
         if let Some(t) = tree {
