@@ -306,7 +306,30 @@ fn interrupt_writes_the_partial_image() {
         .arg(&out)
         .spawn()
         .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(700));
+    // Signal only once the process catches SIGINT (bit 1 of SigCgt in /proc): a fixed wait
+    // lets a slow start on a loaded machine die of the default action instead.
+    let catches_sigint = || {
+        let status = std::fs::read_to_string(format!("/proc/{}/status", child.id()));
+        status.ok().is_some_and(|s| {
+            s.lines()
+                .find_map(|l| l.strip_prefix("SigCgt:"))
+                .and_then(|m| u64::from_str_radix(m.trim(), 16).ok())
+                .is_some_and(|m| m & 2 != 0)
+        })
+    };
+    let start = std::time::Instant::now();
+    let procfs = std::path::Path::new("/proc/self/status").exists();
+    while procfs && !catches_sigint() {
+        let waited = start.elapsed().as_secs();
+        assert!(
+            waited < 60,
+            "the render set no Ctrl-C handler in {waited} s"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    // Without /proc, a fixed wait.
+    let wait = if procfs { 300 } else { 700 };
+    std::thread::sleep(std::time::Duration::from_millis(wait));
     let status = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()

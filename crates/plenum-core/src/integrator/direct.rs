@@ -138,9 +138,29 @@ pub(super) enum Lobes {
     All,
     /// A path also goes on through the specular lobes and finds their light there.
     NonSpecular,
-    /// The light sample took the others in full (a last vertex's, with no BSDF sample
-    /// to weigh it against).
-    Specular,
+}
+
+/// Direct light at a path's last vertex, from which no bounce goes on: a light sample and a
+/// BSDF-sampled ray traced for the light it finds alone, weighed against each other by MIS,
+/// as pbrt-v4's path tracer ends a path. Light sampling alone would leave a sharp glossy
+/// lobe's view of a large lamp to rare samples of enormous weight (Veach's plates), and the
+/// light a specular lobe shows to none. Every eye-path method ends its paths so.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn last_vertex_ld(
+    scene: &Scene,
+    it: &Interaction,
+    wo: Vec3,
+    bsdf: &Bsdf,
+    wl: &SampledWavelengths,
+    stream: &mut SampleStream,
+    counts: &mut RayCounts,
+    time: f64,
+) -> SampledSpectrum {
+    let mut l = SampledSpectrum::ZERO;
+    if bsdf.flags().is_non_specular() {
+        l += sample_ld(scene, it, wo, bsdf, wl, stream, counts, time, 1.0);
+    }
+    l + bsdf_sample_ld(scene, it, wo, bsdf, wl, stream, counts, time, Lobes::All)
 }
 
 /// One BSDF-sampled ray's part of direct light at `it` toward `wo`, for a path that does not
@@ -167,7 +187,6 @@ pub(super) fn bsdf_sample_ld(
     let counted = match lobes {
         Lobes::All => true,
         Lobes::NonSpecular => !bs.is_specular(),
-        Lobes::Specular => bs.is_specular(),
     };
     if !counted {
         return SampledSpectrum::ZERO;

@@ -11,7 +11,6 @@
 //! into linear sRGB once at the end. A sample that comes out NaN or infinite is counted in
 //! [`RayCounts::invalid`] and left out of the film.
 
-use super::direct::Lobes;
 use super::eye_path::EyePath;
 use super::{direct, record, rgb, IntegratorConfig, RayCounts, RayTree, Stop};
 use crate::math::Ray;
@@ -69,23 +68,20 @@ impl<'a> PathTracer<'a> {
                 });
                 break;
             };
-            if bsdf.flags().is_non_specular() {
-                // Weighed against the BSDF-sampled ray, the next bounce's or, at the last
-                // vertex, one traced for its light alone.
-                l += beta * direct::sample_ld(scene, it, wo, &bsdf, wl, stream, counts, time, 1.0);
-            }
             if path.depth >= self.max_depth {
-                // The last vertex still takes the light its BSDF-sampled ray meets (an
+                // The last vertex takes the light its BSDF-sampled ray meets too (an
                 // emitter, the sky, light seen in a mirror), but the path ends here (as
                 // pbrt-v4's and Mitsuba's path tracers count depth).
-                let lobes = Lobes::All;
-                l += beta
-                    * direct::bsdf_sample_ld(scene, it, wo, &bsdf, wl, stream, counts, time, lobes);
+                l += beta * direct::last_vertex_ld(scene, it, wo, &bsdf, wl, stream, counts, time);
                 record(&mut tree, node, |n| {
                     n.color = added(l, wl);
                     n.stops.push(Stop::Depth);
                 });
                 break;
+            }
+            if bsdf.flags().is_non_specular() {
+                // Weighed against the BSDF-sampled ray of the next bounce.
+                l += beta * direct::sample_ld(scene, it, wo, &bsdf, wl, stream, counts, time, 1.0);
             }
             record(&mut tree, node, |n| n.color = added(l, wl));
             let (uc, u) = (stream.next_1d(), stream.next_2d());

@@ -3,8 +3,8 @@
 //! came L S+ D: only specular bounces since the light); the eye pass is traced as the path
 //! tracer traces it through glossy and specular lobes to the first surface with a diffuse
 //! lobe, and adds there, for that diffuse part ([`crate::bxdf::Bsdf::split_diffuse`]; a
-//! surface with both parts is gathered for the one and traced on for the other, and a last
-//! vertex is gathered whole)
+//! surface with both parts is gathered for the one and traced on for the other; a path's
+//! last vertex takes its direct light as the path tracer's does, and no photon)
 //! - direct light, by next-event estimation weighed by MIS against the gather rays that
 //!   find an emitter ([`super::direct`]);
 //! - caustics, the caustic map's density estimate at that point;
@@ -132,28 +132,22 @@ impl<'a> PhotonMapper<'a> {
                 break;
             };
             let (beta, time) = (path.beta, path.ray.time);
+            if path.depth == self.max_depth {
+                // The last vertex, as the path tracer's: no photon of either map can end a
+                // path here (a photon's first landing is direct light).
+                l += beta * direct::last_vertex_ld(scene, it, wo, &bsdf, wl, stream, counts, time);
+                break;
+            }
             // e: the eye vertex, 1 for the camera ray's hit.
             let e = path.depth + 1;
-            let last = path.depth == self.max_depth;
-            if last && bsdf.flags().is_specular() {
-                // The light a last vertex's specular lobes show (a lamp or the sky in a
-                // mirror), which the path tracer's last vertex also takes.
-                let lobes = direct::Lobes::Specular;
-                l += beta
-                    * direct::bsdf_sample_ld(scene, it, wo, &bsdf, wl, stream, counts, time, lobes);
-            }
             // The diffuse part is gathered here, the rest (glossy and specular lobes) traced
-            // on, as the path tracer traces it; a last vertex is gathered whole. A sharp
-            // glossy lobe would see the maps' blur and noise, and through a specular one
-            // the maps would be looked up where the lobe points, not here.
-            let (gathered, traced) = if last {
-                (bsdf.flags().is_non_specular().then_some(bsdf), None)
-            } else {
-                bsdf.split_diffuse()
-            };
+            // on, as the path tracer traces it. A sharp glossy lobe would see the maps' blur
+            // and noise, and through a specular one the maps would be looked up where the
+            // lobe points, not here.
+            let (gathered, traced) = bsdf.split_diffuse();
             if let Some(g) = gathered {
                 // The gather rays are the BSDF samples MIS weighs the light sample against.
-                let n = if last { 0.0 } else { self.gather_rays as f64 };
+                let n = self.gather_rays as f64;
                 l += beta * sample_ld(scene, it, wo, &g, wl, stream, counts, time, n);
                 let mut found = (tree.is_some() && !self.caustic.is_empty()).then(Vec::new);
                 let (caustic, r2) = self.estimate(&self.caustic, it, wo, &g, wl, e, found.as_mut());

@@ -28,12 +28,13 @@
 //! Visible points are made at the first surface with a diffuse lobe, on that lobe alone
 //! ([`crate::bxdf::Bsdf::split_diffuse`]): glossy and specular lobes are traced on, with next-
 //! event estimation under MIS as in the path tracer (pbrt-v4 does so for glossy surfaces: a
-//! sharp glossy lobe times a photon's flux is an estimate of enormous variance); at the
-//! last vertex a glossy surface gets one too. A surface with both parts (a Phong mirror
+//! sharp glossy lobe times a photon's flux is an estimate of enormous variance). A path's
+//! last vertex gets no visible point (no photon could end a path there) and takes its direct
+//! light as the path tracer's does. A surface with both parts (a Phong mirror
 //! with some k_d, a smooth coat) gets a visible point or a traced path, chosen at random by
 //! [`crate::bxdf::Bsdf::diffuse_fraction`] and divided by its probability.
 
-use super::direct::{bsdf_sample_ld, sample_ld, Lobes};
+use super::direct::{bsdf_sample_ld, last_vertex_ld, sample_ld, Lobes};
 use super::eye_path::EyePath;
 use super::photons::{Arrival, PhotonTracer};
 use super::{rgb, FoundPhoton, PhotonGather, RayCounts, RayTree, WholeImage};
@@ -419,14 +420,16 @@ impl Eye<'_> {
             let Some(bsdf) = scene.bsdf(it, wo, &mut wl) else {
                 break;
             };
+            let (beta, t) = (path.beta, path.ray.time);
+            if path.depth == max_depth {
+                // The last vertex, as the path tracer's: no photon could end a path here (a
+                // photon's first landing is direct light), so it needs no visible point.
+                l += beta * last_vertex_ld(scene, it, wo, &bsdf, &wl, &mut stream, counts, t);
+                break;
+            }
             // The diffuse part gets a visible point, the rest (glossy and specular lobes) is
-            // traced on; at the last vertex a diffuse or glossy surface gets one whole.
-            let last = path.depth == max_depth;
-            let (gathered, traced) = if last {
-                (bsdf.flags().is_non_specular().then_some(bsdf), None)
-            } else {
-                bsdf.split_diffuse()
-            };
+            // traced on.
+            let (gathered, traced) = bsdf.split_diffuse();
             // A pixel keeps one visible point, so a surface with both parts is one of the
             // two estimates, chosen with probability q for the visible point and divided by
             // its probability.
@@ -443,25 +446,13 @@ impl Eye<'_> {
                 }
                 parts => parts,
             };
-            let (beta, t) = (path.beta, path.ray.time);
-            if last {
-                // What the path tracer's last vertex also takes: the light its specular
-                // lobes show (a lamp or the sky in a mirror), which no light sample finds.
-                let lobes = Lobes::Specular;
-                l +=
-                    beta * bsdf_sample_ld(scene, it, wo, &bsdf, &wl, &mut stream, counts, t, lobes);
-            }
+            let beta = path.beta;
             if let Some(g) = gathered {
-                // Direct light by MIS of a light sample and one BSDF sample (none at the
-                // last vertex, where a path would not bounce); the traced part's light is
-                // the other estimate's.
-                let n = if last { 0.0 } else { 1.0 };
-                l += beta * sample_ld(scene, it, wo, &g, &wl, &mut stream, counts, t, n);
-                if !last {
-                    let lobes = Lobes::NonSpecular;
-                    let ld = bsdf_sample_ld(scene, it, wo, &g, &wl, &mut stream, counts, t, lobes);
-                    l += beta * ld;
-                }
+                // Direct light by MIS of a light sample and one BSDF sample; the traced
+                // part's light is the other estimate's.
+                l += beta * sample_ld(scene, it, wo, &g, &wl, &mut stream, counts, t, 1.0);
+                let lobes = Lobes::NonSpecular;
+                l += beta * bsdf_sample_ld(scene, it, wo, &g, &wl, &mut stream, counts, t, lobes);
                 if px.stats.radius == 0.0 {
                     px.stats.radius = match s.integrator.photon.radius {
                         r if r > 0.0 => r,
