@@ -10,6 +10,9 @@
 //! - every 16×16 block's mean within 6σ of the reference's (a regional bias, such as a
 //!   ceiling lit through a specular bounce, hides in the image mean).
 //!
+//! Photon mapping, consistent but biased at a fixed photon count, is allowed its documented
+//! bias beyond the noise in each of the three (`Bias`).
+//!
 //! Renders are made at 128×128, half the reference's size: with the box filter a pixel is
 //! the mean of the radiance over its square, so the mean of a 2×2 block of reference pixels
 //! is exactly what a pixel of the half-size image estimates (its variance: the sum of the
@@ -56,6 +59,48 @@ enum Noise {
     /// that most of a pixel's renders never draw: a pixel whose renders drew none has a
     /// low mean *and* a small sample variance, and fails a test that uses the latter.
     Reference,
+}
+
+/// How far beyond its noise a consistent but biased method may be from the reference,
+/// relative to the reference: per pixel channel, over the image, over a 16×16 block. Each
+/// difference is brought that much closer to zero, then tested as an unbiased method's is.
+#[derive(Clone, Copy)]
+struct Bias {
+    pixel: f64,
+    image: f64,
+    block: f64,
+}
+
+const UNBIASED: Bias = Bias {
+    pixel: 0.0,
+    image: 0.0,
+    block: 0.0,
+};
+
+/// Photon mapping's bias at its defaults, as docs/photon-mapping.md states it: density
+/// estimation darkens where a search disc reaches past a surface's edge (corners) and blurs
+/// light over the k nearest photons. Measured (16 renders of 16 spp; 64 for `mis`) with no
+/// allowance: the image mean 5–8σ off on delta and env (0.2–0.3 %), a block 5–16σ on
+/// delta, env, rough and mis (within 2–5 %), 99.63–99.67 % of pixel channels passing on
+/// delta, env and rough (over 99.8 % with 2 %).
+const PHOTON_MAPPING: Bias = Bias {
+    pixel: 0.05,
+    image: 0.005,
+    block: 0.05,
+};
+
+/// Photon mapping where a glass sphere focuses the lamp onto the floor: the caustic map's
+/// estimate blurs the caustic into the sphere's shadow beside it, tens of per cent of that
+/// dark floor, and the block holding it 10 % bright (specular, lens).
+const PHOTON_MAPPING_CAUSTICS: Bias = Bias {
+    pixel: 0.25,
+    image: 0.005,
+    block: 0.12,
+};
+
+/// `d` brought `allowed` closer to zero.
+fn shrink(d: f64, allowed: f64) -> f64 {
+    d.signum() * (d.abs() - allowed).max(0.0)
 }
 
 fn features() -> PathBuf {
@@ -128,8 +173,10 @@ struct Outcome {
     /// The largest, over the channels, of the image's summed variance (the renders' own)
     /// over the summed variance of Mitsuba's estimator at the same samples.
     own_over_mitsuba: f64,
-    /// The image mean's difference from the reference's, in σ, per channel.
+    /// The image mean's difference from the reference's, less the bias allowed, in σ, per
+    /// channel.
     mean_sigma: [f64; 3],
+    /// The image mean's difference from the reference's, relative to it, per channel.
     mean_bias: [f64; 3],
     /// The largest block deviation in σ, and where (block x, y, channel).
     worst_block: (f64, usize, usize, usize),
@@ -142,6 +189,7 @@ fn compare(
     kind: IntegratorKind,
     spp: u32,
     noise: Noise,
+    bias: Bias,
     tweak: impl Fn(&mut RenderSettings),
 ) -> Option<Outcome> {
     let (l, reference) = load(name)?;
@@ -158,6 +206,13 @@ fn compare(
         })
         .collect();
     let (mean, own_var) = mean_and_variance(&images);
+    // What the per-pixel test sees: each difference less the bias allowed.
+    let tested: Vec<[f64; 3]> = (0..SIZE * SIZE)
+        .map(|i| {
+            let r = reference.mean[i];
+            [0, 1, 2].map(|c| r[c] + shrink(mean[i][c] - r[c], bias.pixel * r[c].abs()))
+        })
+        .collect();
     let samples = (RENDERS * spp as u64) as f64;
     let var = match noise {
         Noise::Own => own_var.clone(),
@@ -204,12 +259,12 @@ fn compare(
         }
     }
     let (pass_rate, squared_over_predicted, z_max) =
-        z_test(&mean, &var, &reference.mean, &reference.var);
+        z_test(&tested, &var, &reference.mean, &reference.var);
     // The failing channels, high and low: rare heavy samples fail on the high side.
     let (mut high, mut low) = (0, 0);
     for i in 0..SIZE * SIZE {
         for c in 0..3 {
-            let d = mean[i][c] - reference.mean[i][c];
+            let d = tested[i][c] - reference.mean[i][c];
             if d.abs() > z_max * (var[i][c] + reference.var[i][c]).sqrt() {
                 if d > 0.0 {
                     high += 1
@@ -223,33 +278,35 @@ fn compare(
         "{name}, {}: failing channels {high} high, {low} low",
         kind.name()
     );
-    // Means over regions: the difference and its σ, per channel.
-    let region = |x0: usize, y0: usize, side: usize, c: usize| -> (f64, f64) {
-        let (mut d, mut v) = (0.0, 0.0);
+    // Means over regions: the difference, less the bias `allowed` of the reference's
+    // mean there, and its σ, per channel.
+    let region = |x0: usize, y0: usize, side: usize, c: usize, allowed: f64| -> (f64, f64) {
+        let (mut d, mut v, mut r) = (0.0, 0.0, 0.0);
         for y in y0..y0 + side {
             for x in x0..x0 + side {
                 let i = y * SIZE + x;
                 d += mean[i][c] - reference.mean[i][c];
                 v += var[i][c] + reference.var[i][c];
+                r += reference.mean[i][c];
             }
         }
         let n = (side * side) as f64;
-        (d / n, v.sqrt() / n)
+        (shrink(d / n, allowed * (r / n).abs()), v.sqrt() / n)
     };
     let mut mean_sigma = [0.0; 3];
     let mut mean_bias = [0.0; 3];
     for c in 0..3 {
-        let (d, sigma) = region(0, 0, SIZE, c);
+        let (d, sigma) = region(0, 0, SIZE, c, bias.image);
         mean_sigma[c] = d / sigma;
         let reference_mean =
             reference.mean.iter().map(|p| p[c]).sum::<f64>() / (SIZE * SIZE) as f64;
-        mean_bias[c] = d / reference_mean;
+        mean_bias[c] = region(0, 0, SIZE, c, 0.0).0 / reference_mean;
     }
     let mut worst_block = (0.0, 0, 0, 0);
     for by in 0..SIZE / BLOCK {
         for bx in 0..SIZE / BLOCK {
             for c in 0..3 {
-                let (d, sigma) = region(bx * BLOCK, by * BLOCK, BLOCK, c);
+                let (d, sigma) = region(bx * BLOCK, by * BLOCK, BLOCK, c, bias.block);
                 let z = if sigma > 0.0 {
                     d / sigma
                 } else if d == 0.0 {
@@ -315,9 +372,10 @@ fn passes(
     kind: IntegratorKind,
     spp: u32,
     noise: Noise,
+    bias: Bias,
     tweak: impl Fn(&mut RenderSettings),
 ) {
-    let Some(o) = compare(name, kind, spp, noise, tweak) else {
+    let Some(o) = compare(name, kind, spp, noise, bias, tweak) else {
         return;
     };
     let what = format!("{name} by {}", kind.name());
@@ -349,11 +407,11 @@ fn passes(
 }
 
 macro_rules! reference_tests {
-    ($($test:ident: $scene:literal, $kind:ident, $spp:literal, $noise:ident;)*) => {$(
+    ($($test:ident: $scene:literal, $kind:ident, $spp:literal, $noise:ident, $bias:ident;)*) => {$(
         #[test]
         #[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
         fn $test() {
-            passes($scene, IntegratorKind::$kind, $spp, Noise::$noise, |_| {});
+            passes($scene, IntegratorKind::$kind, $spp, Noise::$noise, $bias, |_| {});
         }
     )*};
 }
@@ -387,28 +445,39 @@ macro_rules! reference_tests {
 //            largest lamp, which light paths reach through that nearly specular lobe
 //            rarely and with large weights. Not a bias: single renders of 4096 spp put that
 //            block 11 %, 11 %, 6 % and 4 % low, and the mean of eight +0.4 %.
+//   photon   (its bias allowed; image mean relative, raw) specular 16: 99.782 %, −0.20 % ·
+//            rough 16: 99.923 %, −0.24 % · mis 64: 99.996 %, +0.35 % · env 16: 99.925 %,
+//            +0.22 % · delta 16: 99.937 %, −0.31 % · lens 16: 99.764 %, −0.19 %. On mis a
+//            block was 53 % dark (5σ) while photon mapping's last vertex took its light
+//            sample alone.
 // Light tracing cannot render specular, lens and env: their camera sees a smooth surface or
 // the environment directly, which no light path reaches.
 reference_tests! {
-    path_specular: "specular", Path, 256, Reference;
-    path_lens: "lens", Path, 256, Reference;
-    path_rough: "rough", Path, 256, Reference;
-    path_delta: "delta", Path, 16, Own;
-    path_env: "env", Path, 16, Own;
-    path_mis: "mis", Path, 64, Own;
-    bdpt_specular: "specular", Bdpt, 16, Own;
-    bdpt_rough: "rough", Bdpt, 16, Own;
-    bdpt_mis: "mis", Bdpt, 64, Own;
-    bdpt_env: "env", Bdpt, 16, Own;
-    bdpt_delta: "delta", Bdpt, 16, Own;
-    bdpt_lens: "lens", Bdpt, 16, Own;
-    sppm_specular: "specular", Sppm, 16, Own;
-    sppm_rough: "rough", Sppm, 16, Own;
-    sppm_mis: "mis", Sppm, 64, Own;
-    sppm_env: "env", Sppm, 16, Own;
-    sppm_delta: "delta", Sppm, 32, Own;
-    sppm_lens: "lens", Sppm, 16, Own;
-    light_delta: "delta", Light, 128, Own;
-    light_rough: "rough", Light, 64, Own;
-    light_mis: "mis", Light, 1024, Own;
+    path_specular: "specular", Path, 256, Reference, UNBIASED;
+    path_lens: "lens", Path, 256, Reference, UNBIASED;
+    path_rough: "rough", Path, 256, Reference, UNBIASED;
+    path_delta: "delta", Path, 16, Own, UNBIASED;
+    path_env: "env", Path, 16, Own, UNBIASED;
+    path_mis: "mis", Path, 64, Own, UNBIASED;
+    bdpt_specular: "specular", Bdpt, 16, Own, UNBIASED;
+    bdpt_rough: "rough", Bdpt, 16, Own, UNBIASED;
+    bdpt_mis: "mis", Bdpt, 64, Own, UNBIASED;
+    bdpt_env: "env", Bdpt, 16, Own, UNBIASED;
+    bdpt_delta: "delta", Bdpt, 16, Own, UNBIASED;
+    bdpt_lens: "lens", Bdpt, 16, Own, UNBIASED;
+    sppm_specular: "specular", Sppm, 16, Own, UNBIASED;
+    sppm_rough: "rough", Sppm, 16, Own, UNBIASED;
+    sppm_mis: "mis", Sppm, 64, Own, UNBIASED;
+    sppm_env: "env", Sppm, 16, Own, UNBIASED;
+    sppm_delta: "delta", Sppm, 32, Own, UNBIASED;
+    sppm_lens: "lens", Sppm, 16, Own, UNBIASED;
+    light_delta: "delta", Light, 128, Own, UNBIASED;
+    light_rough: "rough", Light, 64, Own, UNBIASED;
+    light_mis: "mis", Light, 1024, Own, UNBIASED;
+    photon_specular: "specular", Photon, 16, Own, PHOTON_MAPPING_CAUSTICS;
+    photon_rough: "rough", Photon, 16, Own, PHOTON_MAPPING;
+    photon_mis: "mis", Photon, 64, Own, PHOTON_MAPPING;
+    photon_env: "env", Photon, 16, Own, PHOTON_MAPPING;
+    photon_delta: "delta", Photon, 16, Own, PHOTON_MAPPING;
+    photon_lens: "lens", Photon, 16, Own, PHOTON_MAPPING_CAUSTICS;
 }

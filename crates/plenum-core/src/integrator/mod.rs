@@ -271,6 +271,30 @@ pub(crate) fn test_image_mean(
     pixels.iter().map(|p| p[1] as f64).sum::<f64>() / pixels.len() as f64
 }
 
+/// For the integrators' tests: `kind`'s image of the kit's floor under a disk lamp and under
+/// a point light, direct light only (`max_depth` 0), 16 × 16 pixels of `spp` samples (seed
+/// 9), within `tolerance` (relative) of the closed forms of
+/// [`crate::kit::lamp_over_floor_radiance`].
+#[cfg(test)]
+pub(crate) fn assert_lamp_over_floor(kind: IntegratorKind, spp: u32, tolerance: f64) {
+    for point in [false, true] {
+        let scene = crate::kit::lamp_over_floor(0.5, point);
+        let config = IntegratorConfig {
+            kind,
+            max_depth: 0,
+            color: plenum_spectrum::ColorMode::Rgb,
+            ..IntegratorConfig::default()
+        };
+        let mean = test_image_mean(&scene, &config, 16, spp, 9);
+        let expected = crate::kit::lamp_over_floor_image_mean(0.5, point, 16);
+        assert!(
+            (mean / expected - 1.0).abs() < tolerance,
+            "{}, point light {point}: {mean:.5}, expected {expected:.5}",
+            kind.name()
+        );
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

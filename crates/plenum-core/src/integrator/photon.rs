@@ -15,8 +15,9 @@
 //!   glossy lobes, and goes on where its BSDF sample is specular, for the rest.
 //!
 //! A density estimate is Σ f(ωo, ωp)·Φp / (π r²) over the k nearest photons facing the same
-//! way and on the same surface ([`super::photon_map::SURFACE`]), r the distance of the (k + 1)-th (which makes k/(π r²) an unbiased density for
-//! photons spread evenly on a plane), or the search bound where fewer are found.
+//! way and on the same surface ([`super::photon_map::SURFACE`]), r the distance of the
+//! (k + 1)-th (which makes k/(π r²) an unbiased density for photons spread evenly on a
+//! plane), or the search bound where fewer are found.
 //!
 //! The passes are deterministic: photon path i takes its random numbers from (seed, pass, i)
 //! and chunks of paths are traced in parallel and joined in order.

@@ -391,8 +391,8 @@ struct Eye<'a> {
 }
 
 impl Eye<'_> {
-    /// Traces pixel (x, y)'s camera path: adds the light it finds to `px.stats.direct` and leaves its
-    /// visible point in `px.vp`.
+    /// Traces pixel (x, y)'s camera path: adds the light it finds to `px.stats.direct` and
+    /// leaves its visible point in `px.vp`.
     fn camera_path(
         &self,
         x: u32,
