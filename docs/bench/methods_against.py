@@ -8,7 +8,8 @@
 
 Each scene (the built-in one, scenes/cornell-box.toml and scenes/glass.toml unless
 `--scenes` names others) is rendered by every method at 160×120 with the samples of `SPP`
-(random sampler, seed 1, 2 threads), by the base build and the new one in turn, `--rounds`
+(about a second each; random sampler, seed 1, 2 threads, the scene's colour mode unless
+`--color` names one for the physically based methods), by the base build and the new one in turn, `--rounds`
 times over, so that the machine's drift falls on both alike. A run's time is the render's own
 as Plenum reports it ("…, T s, method"), without loading. Prints, per scene and method, the
 median times and new ÷ base; at the end the largest ratio. Both builds must take the same
@@ -23,20 +24,21 @@ import sys
 import tempfile
 
 SPP = {
-    "local": 64,
-    "appel": 64,
-    "whitted": 64,
-    "path": 32,
-    "light": 32,
-    "bdpt": 16,
-    "photon": 8,
-    "sppm": 16,
+    "local": 512,
+    "appel": 256,
+    "whitted": 128,
+    "path": 64,
+    "light": 64,
+    "bdpt": 32,
+    "photon": 16,
+    "sppm": 32,
 }
 TIME = re.compile(r"spp, ([0-9.]+) s, ")
 
 
-def render(plenum, scene, method, out):
+def render(plenum, scene, method, out, color):
     args = [plenum, "render"] + ([scene] if scene != "builtin" else [])
+    args += ["--color", color] if color else []
     args += ["--integrator", method, "--spp", str(SPP[method]), "--sampler", "random"]
     args += ["--seed", "1", "--threads", "2", "--width", "160", "--height", "120", "-o", out]
     p = subprocess.run(args, capture_output=True, text=True, timeout=600)
@@ -55,6 +57,7 @@ def main():
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--scenes", nargs="*", default=["builtin", "scenes/cornell-box.toml", "scenes/glass.toml"])
     ap.add_argument("--methods", nargs="*", default=list(SPP))
+    ap.add_argument("--color", help="rgb or spectral for the physically based methods (default: the scene's)")
     a = ap.parse_args()
     times = {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -63,7 +66,8 @@ def main():
             for scene in a.scenes:
                 for method in a.methods:
                     for build, plenum in (("base", a.base), ("new", a.new)):
-                        t = render(plenum, scene, method, out)
+                        pb = method not in ("local", "appel", "whitted")
+                        t = render(plenum, scene, method, out, a.color if pb else None)
                         times.setdefault((scene, method, build), []).append(t)
             print(f"round {r + 1} of {a.rounds} done", file=sys.stderr)
     print(f"| scene | method | spp | base (s) | new (s) | new ÷ base |")
