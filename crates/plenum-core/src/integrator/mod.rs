@@ -156,9 +156,35 @@ impl<'a> Integrator<'a> {
         counts: &mut RayCounts,
         tree: Option<&mut RayTree>,
     ) -> Color {
-        let mut wl = sample_wavelengths(self.color(), stream);
-        let l = match self {
-            // Whitted's model is RGB, its tree of colours.
+        let c = match self {
+            // Whitted's model is RGB, its tree of colours: no wavelengths, no spectrum.
+            Integrator::Whitted(w) => {
+                counts.camera += 1;
+                w.camera_ray(ray, stream, counts, tree)
+            }
+            _ => {
+                let mut wl = sample_wavelengths(self.color(), stream);
+                rgb(self.li(ray, &mut wl, stream, counts, tree), &wl)
+            }
+        };
+        if !(c.r.is_finite() && c.g.is_finite() && c.b.is_finite()) {
+            counts.invalid += 1;
+            return Color::BLACK;
+        }
+        c
+    }
+
+    /// The method's radiance along a camera ray at the wavelengths `wl` (Whitted's RGB in
+    /// the first three lanes, though `camera_ray` takes Whitted's colour as it is).
+    fn li(
+        &self,
+        ray: &Ray,
+        wl: &mut SampledWavelengths,
+        stream: &mut SampleStream,
+        counts: &mut RayCounts,
+        tree: Option<&mut RayTree>,
+    ) -> SampledSpectrum {
+        match self {
             Integrator::Whitted(w) => {
                 counts.camera += 1;
                 let c = w.camera_ray(ray, stream, counts, tree);
@@ -166,28 +192,22 @@ impl<'a> Integrator<'a> {
             }
             Integrator::Path(p) => {
                 counts.camera += 1;
-                p.li(ray, &mut wl, stream, counts, tree)
+                p.li(ray, wl, stream, counts, tree)
             }
             // A light path per sample; what reaches the camera is splatted.
             Integrator::Light(l) => {
-                l.light_path(ray.time, &mut wl, stream, counts, tree);
+                l.light_path(ray.time, wl, stream, counts, tree);
                 SampledSpectrum::ZERO
             }
             Integrator::Bdpt(b) => {
                 counts.camera += 1;
-                b.li(ray, &mut wl, stream, counts, tree)
+                b.li(ray, wl, stream, counts, tree)
             }
             Integrator::Photon(p) => {
                 counts.camera += 1;
-                p.li(ray, &mut wl, stream, counts, tree)
+                p.li(ray, wl, stream, counts, tree)
             }
-        };
-        let c = rgb(l, &wl);
-        if !(c.r.is_finite() && c.g.is_finite() && c.b.is_finite()) {
-            counts.invalid += 1;
-            return Color::BLACK;
         }
-        c
     }
 
     /// How the method represents light.
