@@ -1081,11 +1081,13 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
         }
         return ExitCode::from(1);
     }
-    // Refused above wherever the film has no variance image.
-    if let (Some(path), Some(v)) = (&variance_output, film.variance_image()) {
-        if let Err(e) = plenum_image::write_image(path, v.width, v.height, v.pixels(), 0.0) {
-            eprintln!("error: {e}");
-            return ExitCode::from(1);
+    // Refused above wherever the film has no variance image; computed only when asked for.
+    if let Some(path) = &variance_output {
+        if let Some(v) = film.variance_image() {
+            if let Err(e) = plenum_image::write_image(path, v.width, v.height, v.pixels(), 0.0) {
+                eprintln!("error: {e}");
+                return ExitCode::from(1);
+            }
         }
     }
     if let Some(dir) = &args.write_strategies {

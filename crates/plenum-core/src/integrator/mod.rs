@@ -68,6 +68,19 @@ pub(crate) fn sample_wavelengths(
     }
 }
 
+/// A physically based method's estimate `li` at the wavelengths the stream draws, as a
+/// colour.
+#[inline]
+fn spectral(
+    color: ColorMode,
+    stream: &mut SampleStream,
+    li: impl FnOnce(&mut SampledWavelengths, &mut SampleStream) -> SampledSpectrum,
+) -> Color {
+    let mut wl = sample_wavelengths(color, stream);
+    let l = li(&mut wl, stream);
+    rgb(l, &wl)
+}
+
 /// A method that renders the whole image by a loop of its own rather than pixel sample by
 /// pixel sample: the film it needs, the render into it, and the ray tree of one pixel.
 pub trait WholeImage: Sync {
@@ -162,9 +175,22 @@ impl<'a> Integrator<'a> {
                 counts.camera += 1;
                 w.camera_ray(ray, stream, counts, tree)
             }
-            _ => {
-                let mut wl = sample_wavelengths(self.color(), stream);
-                rgb(self.li(ray, &mut wl, stream, counts, tree), &wl)
+            Integrator::Path(p) => {
+                counts.camera += 1;
+                spectral(p.color, stream, |wl, s| p.li(ray, wl, s, counts, tree))
+            }
+            // A light path per sample; what reaches the camera is splatted.
+            Integrator::Light(l) => spectral(l.color, stream, |wl, s| {
+                l.light_path(ray.time, wl, s, counts, tree);
+                SampledSpectrum::ZERO
+            }),
+            Integrator::Bdpt(b) => {
+                counts.camera += 1;
+                spectral(b.color, stream, |wl, s| b.li(ray, wl, s, counts, tree))
+            }
+            Integrator::Photon(p) => {
+                counts.camera += 1;
+                spectral(p.color, stream, |wl, s| p.li(ray, wl, s, counts, tree))
             }
         };
         if !(c.r.is_finite() && c.g.is_finite() && c.b.is_finite()) {
@@ -172,53 +198,6 @@ impl<'a> Integrator<'a> {
             return Color::BLACK;
         }
         c
-    }
-
-    /// The method's radiance along a camera ray at the wavelengths `wl` (Whitted's RGB in
-    /// the first three lanes, though `camera_ray` takes Whitted's colour as it is).
-    fn li(
-        &self,
-        ray: &Ray,
-        wl: &mut SampledWavelengths,
-        stream: &mut SampleStream,
-        counts: &mut RayCounts,
-        tree: Option<&mut RayTree>,
-    ) -> SampledSpectrum {
-        match self {
-            Integrator::Whitted(w) => {
-                counts.camera += 1;
-                let c = w.camera_ray(ray, stream, counts, tree);
-                SampledSpectrum([c.r, c.g, c.b, 0.0])
-            }
-            Integrator::Path(p) => {
-                counts.camera += 1;
-                p.li(ray, wl, stream, counts, tree)
-            }
-            // A light path per sample; what reaches the camera is splatted.
-            Integrator::Light(l) => {
-                l.light_path(ray.time, wl, stream, counts, tree);
-                SampledSpectrum::ZERO
-            }
-            Integrator::Bdpt(b) => {
-                counts.camera += 1;
-                b.li(ray, wl, stream, counts, tree)
-            }
-            Integrator::Photon(p) => {
-                counts.camera += 1;
-                p.li(ray, wl, stream, counts, tree)
-            }
-        }
-    }
-
-    /// How the method represents light.
-    fn color(&self) -> ColorMode {
-        match self {
-            Integrator::Whitted(_) => ColorMode::Rgb,
-            Integrator::Path(p) => p.color,
-            Integrator::Light(l) => l.color,
-            Integrator::Bdpt(b) => b.color,
-            Integrator::Photon(p) => p.color,
-        }
     }
 
     /// The rays traced before rendering (photon mapping's photon pass).

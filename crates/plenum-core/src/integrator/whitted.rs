@@ -154,7 +154,8 @@ impl<'a> Whitted<'a> {
         // A surface that neither diffuses nor highlights (an emitter, a mirror, clear
         // glass) needs no shadow rays.
         let lit = !(k.diffuse.is_black() && k.specular.is_black());
-        for (li, light) in self.scene.lights.iter().enumerate().filter(|_| lit) {
+        for &li in self.scene.lights.whitted.iter().filter(|_| lit) {
+            let light = &self.scene.lights[li as usize];
             // An area light's m × m shadow rays share one offset from the stream, each in
             // its own cell: stratified within the shading point, and the offset stratified
             // across the pixel's samples.
@@ -179,7 +180,7 @@ impl<'a> Whitted<'a> {
                     continue;
                 }
                 let s = if self.config.shadows {
-                    self.shadow(ray, &it, n, &inc, li, &mut b, node, counts)
+                    self.shadow(ray, &it, n, &inc, li as usize, &mut b, node, counts)
                 } else {
                     Color::WHITE
                 };

@@ -17,6 +17,9 @@ pub struct Lights {
     spectra: Vec<SpectrumValue>,
     /// The lights at infinity, which rays that hit nothing see.
     pub infinite: Vec<u32>,
+    /// The lights of Whitted's model, which it sums over at every hit: all but those at
+    /// infinity (a background light among them would cost every hit a light for nothing).
+    pub whitted: Vec<u32>,
     /// Chooses a light for next-event estimation.
     pub sampler: LightSampler,
     /// The scene's background as a light (a uniform infinite light), where it is not black.
@@ -47,14 +50,14 @@ impl Lights {
                 None => SpectrumValue::from_rgb(l.rgb(), SpectrumKind::Illuminant),
             })
             .collect();
-        let infinite = (0..all.len() as u32)
-            .filter(|&i| all[i as usize].is_infinite())
-            .collect();
+        let (infinite, whitted) =
+            (0..all.len() as u32).partition(|&i| all[i as usize].is_infinite());
         Lights {
             all,
             names,
             spectra,
             infinite,
+            whitted,
             sampler: LightSampler::default(),
             background,
         }
