@@ -9,6 +9,7 @@ mod embree;
 mod film_file;
 mod memory;
 mod trace;
+mod view;
 
 use clap::{Args, Parser, Subcommand};
 use plenum_core::accel::AccelKind;
@@ -51,6 +52,9 @@ enum Command {
     /// Sum film files (.plf) of one render's sample ranges (`render --samples A..B`) into
     /// its image.
     Merge(MergeArgs),
+    /// Serve a page that shows the render as it forms, restarts it with other settings,
+    /// and shows the ray tree of a clicked pixel (`--port`, `--bind`; loopback by default).
+    View(view::Args),
 }
 
 #[derive(Args)]
@@ -444,6 +448,7 @@ fn main() -> ExitCode {
         Command::Convert(args) => convert(args),
         Command::Bench(args) => bench::run(args),
         Command::Merge(args) => merge(args),
+        Command::View(args) => view::run(args),
     }
 }
 
@@ -467,6 +472,15 @@ fn load(path: Option<&Path>, accel: AccelKind) -> Result<LoadedScene, ExitCode> 
 }
 
 fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings, ExitCode> {
+    render_settings(view, loaded).map_err(|e| {
+        eprintln!("error: {e}");
+        ExitCode::from(2)
+    })
+}
+
+/// The render's settings: `view`'s, else the scene file's; an error says what is wrong.
+/// Warnings go to stderr.
+fn render_settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings, String> {
     if let (true, Some(angle)) = (view.nff_corners, loaded.defaults.nff_angle) {
         loaded.scene.camera.fov_degrees = angle;
     }
@@ -474,23 +488,21 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
     let width = view.width.unwrap_or(d.width);
     let height = view.height.unwrap_or(d.height);
     if width == 0 || height == 0 {
-        eprintln!("error: the image must be at least 1×1 pixels");
-        return Err(ExitCode::from(2));
+        return Err("the image must be at least 1×1 pixels".into());
     }
     // 2^28 pixels (16384 × 16384) is 3 GiB of film: beyond that, refuse rather than abort.
     if width as u64 * height as u64 > 1 << 28 {
-        eprintln!("error: {width}×{height} is too large: at most 2^28 pixels (16384×16384)");
-        return Err(ExitCode::from(2));
+        return Err(format!(
+            "{width}×{height} is too large: at most 2^28 pixels (16384×16384)"
+        ));
     }
     let spp = view.spp.unwrap_or(d.spp);
     if spp == 0 || spp > MAX_SPP {
-        eprintln!("error: --spp must be between 1 and {MAX_SPP}");
-        return Err(ExitCode::from(2));
+        return Err(format!("--spp must be between 1 and {MAX_SPP}"));
     }
     let max_depth = view.max_depth.unwrap_or(d.max_depth);
     if max_depth > MAX_DEPTH {
-        eprintln!("error: --max-depth must be at most {MAX_DEPTH}");
-        return Err(ExitCode::from(2));
+        return Err(format!("--max-depth must be at most {MAX_DEPTH}"));
     }
     let chosen = view.sampler.unwrap_or(if d.adaptive {
         SamplerArg::Adaptive
@@ -521,20 +533,15 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
         (None, None, Some(r)) => r,
         _ => filter_kind.default_radius(),
     };
-    let filter = Filter::new(filter_kind, radius).map_err(|e| {
-        eprintln!("error: --filter-radius: {e}");
-        ExitCode::from(2)
-    })?;
+    let filter = Filter::new(filter_kind, radius).map_err(|e| format!("--filter-radius: {e}"))?;
     let adaptive = match (chosen, view.noise_threshold) {
         (SamplerArg::Fixed(_), Some(_)) => {
-            eprintln!("error: --noise-threshold needs --sampler adaptive");
-            return Err(ExitCode::from(2));
+            return Err("--noise-threshold needs --sampler adaptive".into());
         }
         (SamplerArg::Fixed(_), None) => None,
         (SamplerArg::Adaptive, Some(threshold)) => {
             if !(threshold > 0.0 && threshold.is_finite()) {
-                eprintln!("error: --noise-threshold must be a positive number");
-                return Err(ExitCode::from(2));
+                return Err("--noise-threshold must be a positive number".into());
             }
             // The budget is --spp; without one, at least 16 batches whatever the file says.
             let max_spp = match view.spp {
@@ -542,8 +549,7 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
                 None => spp.max(16 * view.min_spp).min(MAX_SPP),
             };
             if view.min_spp < 2 || view.min_spp > max_spp {
-                eprintln!("error: --min-spp must be between 2 and --spp ({max_spp})");
-                return Err(ExitCode::from(2));
+                return Err(format!("--min-spp must be between 2 and --spp ({max_spp})"));
             }
             Some(Adaptive::Variance {
                 threshold,
@@ -553,12 +559,12 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
         }
         (SamplerArg::Adaptive, None) => {
             if !(1..=MAX_SUBDIVISION).contains(&view.adaptive_depth) {
-                eprintln!("error: --adaptive-depth must be between 1 and {MAX_SUBDIVISION}");
-                return Err(ExitCode::from(2));
+                return Err(format!(
+                    "--adaptive-depth must be between 1 and {MAX_SUBDIVISION}"
+                ));
             }
             if !(view.contrast >= 0.0 && view.contrast.is_finite()) {
-                eprintln!("error: --contrast must be a number ≥ 0");
-                return Err(ExitCode::from(2));
+                return Err("--contrast must be a number ≥ 0".into());
             }
             Some(Adaptive::Subdivide {
                 contrast: view.contrast,
@@ -596,8 +602,7 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
     photon.sppm_photons = view.sppm_photons.unwrap_or(photon.sppm_photons);
     photon.alpha = view.sppm_alpha.unwrap_or(photon.alpha);
     if let Err((key, e)) = photon.check_field() {
-        eprintln!("error: --{}: {e}", key.replace('_', "-"));
-        return Err(ExitCode::from(2));
+        return Err(format!("--{}: {e}", key.replace('_', "-")));
     }
     let settings = RenderSettings {
         width,
@@ -618,8 +623,7 @@ fn settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSettings,
         corners: view.nff_corners,
     };
     if let Err(e) = settings.check() {
-        eprintln!("error: {e}");
-        return Err(ExitCode::from(2));
+        return Err(e.to_string());
     }
     Ok(settings)
 }

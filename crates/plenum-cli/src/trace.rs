@@ -34,12 +34,7 @@ pub fn run(args: TracePixelArgs) -> ExitCode {
     let (tree, color) = trace_pixel(&loaded.scene, &settings, x, y);
     let mut out = String::new();
     if args.json {
-        let doc = json!({
-            "pixel": [x, y],
-            "color": rgb(color),
-            "rays": tree.nodes.iter().enumerate().map(|(i, n)| node_json(i, n)).collect::<Vec<_>>(),
-        });
-        out = serde_json::to_string_pretty(&doc).unwrap_or_default();
+        out = serde_json::to_string_pretty(&tree_json((x, y), &tree, color)).unwrap_or_default();
         out.push('\n');
     } else {
         let _ = writeln!(out, "pixel ({x}, {y}): colour {}", fmt_color(color));
@@ -50,6 +45,15 @@ pub fn run(args: TracePixelArgs) -> ExitCode {
     // A reader that stops early (`| head`) is not an error.
     let _ = std::io::stdout().lock().write_all(out.as_bytes());
     ExitCode::SUCCESS
+}
+
+/// The ray tree of pixel (x, y) and its colour, as `--json` prints it.
+pub(crate) fn tree_json((x, y): (u32, u32), tree: &RayTree, color: Color) -> Value {
+    json!({
+        "pixel": [x, y],
+        "color": rgb(color),
+        "rays": tree.nodes.iter().enumerate().map(|(i, n)| node_json(i, n)).collect::<Vec<_>>(),
+    })
 }
 
 /// The photons of a density estimate the text listing shows; `--json` gives them all.

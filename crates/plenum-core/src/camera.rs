@@ -311,6 +311,37 @@ impl Camera {
             + f.up * (self.half_height - y * self.pixel_size)
     }
 
+    /// The world segment from `a` to `b` as the camera sees it (at time 0, from the lens
+    /// centre): its ends in raster coordinates, inside the image or not, after cutting off
+    /// what lies behind the camera; `None` where all of it does. For drawing rays over the
+    /// image.
+    pub fn project_segment(&self, a: Vec3, b: Vec3) -> Option<([f64; 2], [f64; 2])> {
+        let frame = self.frame_at(0.0);
+        let depth = |p: Vec3| (p - frame.position).dot(frame.forward);
+        let (za, zb) = (depth(a), depth(b));
+        // Points this close to the lens's plane would project to no sensible place.
+        let near = 1e-6 * (za.abs() + zb.abs()).max(f64::MIN_POSITIVE);
+        if za < near && zb < near {
+            return None;
+        }
+        let cut = |p: Vec3, zp: f64, q: Vec3, zq: f64| {
+            if zp >= near {
+                p
+            } else {
+                p + (q - p) * ((near - zp) / (zq - zp))
+            }
+        };
+        let (a, b) = (cut(a, za, b, zb), cut(b, zb, a, za));
+        let raster = |p: Vec3| {
+            let d = (p - frame.position) / depth(p);
+            [
+                (d.dot(frame.right) + self.half_width) / self.pixel_size,
+                (self.half_height - d.dot(frame.up)) / self.pixel_size,
+            ]
+        };
+        Some((raster(a), raster(b)))
+    }
+
     /// Size of one pixel on a plane facing the camera at distance `depth`, in scene units.
     pub fn pixel_footprint(&self, depth: f64) -> f64 {
         self.pixel_size * depth
@@ -320,6 +351,37 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A point that a camera ray passes through projects back to that ray's raster point;
+    /// a segment reaching behind the camera is cut where it crosses the lens's plane.
+    #[test]
+    fn project_segment_inverts_camera_rays() {
+        let s = CameraSettings {
+            position: Vec3::new(1.0, 2.0, 10.0),
+            look_at: Vec3::new(0.5, 0.0, 0.0),
+            up: Vec3::Y,
+            fov_degrees: 50.0,
+            ..CameraSettings::default()
+        };
+        let cam = Camera::new(&s, 64, 48);
+        let r1 = cam.ray(10.25, 40.5);
+        let r2 = cam.ray(60.0, 3.0);
+        let (a, b) = cam
+            .project_segment(r1.at(3.0), r2.at(7.0))
+            .expect("in front of the camera");
+        for (got, want) in [(a, [10.25, 40.5]), (b, [60.0, 3.0])] {
+            assert!((got[0] - want[0]).abs() < 1e-9 && (got[1] - want[1]).abs() < 1e-9);
+        }
+        let behind = s.position + (s.position - s.look_at);
+        assert!(cam.project_segment(behind, behind + Vec3::X).is_none());
+        // From the centre of view to behind the camera: the near end stays at the centre,
+        // the far end goes off the image (the segment heads out of view).
+        let (c, d) = cam
+            .project_segment(cam.ray(32.0, 24.0).at(5.0), behind + Vec3::Y)
+            .unwrap();
+        assert!((c[0] - 32.0).abs() < 1e-9 && (c[1] - 24.0).abs() < 1e-9);
+        assert!(d[0].abs() > 1e3 || d[1].abs() > 1e3, "{d:?}");
+    }
 
     #[test]
     fn centre_ray_looks_at_target_and_edges_span_the_fov() {

@@ -116,6 +116,17 @@ impl PixelSampler {
         }
     }
 
+    /// Which pattern this is.
+    pub fn kind(&self) -> SamplerKind {
+        match self {
+            PixelSampler::Grid { .. } => SamplerKind::Grid,
+            PixelSampler::Random { .. } => SamplerKind::Random,
+            PixelSampler::Jittered { .. } => SamplerKind::Jittered,
+            PixelSampler::Cook16 { .. } => SamplerKind::Cook16,
+            PixelSampler::Sobol { .. } => SamplerKind::Sobol,
+        }
+    }
+
     pub fn samples_per_pixel(&self) -> u32 {
         match *self {
             PixelSampler::Grid { n } | PixelSampler::Jittered { n } => n * n,
