@@ -7,6 +7,7 @@
 //! lecture's model, `physical.rs` for pbrt-v4's set, `param.rs` for their parameters.
 
 mod param;
+pub(crate) use param::scaled_sigmoid;
 mod phong;
 mod physical;
 

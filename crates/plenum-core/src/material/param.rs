@@ -193,14 +193,10 @@ pub(crate) fn uplift_at(c: Color, kind: SpectrumKind, wl: &SampledWavelengths) -
     let table = RgbToSpectrumTable::srgb();
     let (scale, sigmoid) = match kind {
         SpectrumKind::Albedo => (1.0, table.lookup(rgb)),
-        SpectrumKind::Unbounded | SpectrumKind::Illuminant => {
-            let m = rgb[0].max(rgb[1]).max(rgb[2]);
-            if m == 0.0 {
-                return SampledSpectrum::ZERO;
-            }
-            let scale = 2.0 * m;
-            (scale, table.lookup(rgb.map(|v| v / scale)))
-        }
+        SpectrumKind::Unbounded | SpectrumKind::Illuminant => match scaled_sigmoid(rgb) {
+            Some(fit) => fit,
+            None => return SampledSpectrum::ZERO,
+        },
     };
     let mut s = SampledSpectrum::ZERO;
     for (i, &l) in wl.lambda().iter().enumerate() {
@@ -210,6 +206,21 @@ pub(crate) fn uplift_at(c: Color, kind: SpectrumKind, wl: &SampledWavelengths) -
         }
     }
     s
+}
+
+/// A non-negative RGB value of no bound as pbrt-v4 uplifts it: a scale, twice its largest
+/// channel, and the sigmoid of the reflectance it scales (an illuminant's spectrum is their
+/// product times D65 of unit luminance); `None` for black.
+pub(crate) fn scaled_sigmoid(rgb: [f64; 3]) -> Option<(f64, RgbSigmoid)> {
+    let m = rgb[0].max(rgb[1]).max(rgb[2]);
+    if m == 0.0 {
+        return None;
+    }
+    let scale = 2.0 * m;
+    Some((
+        scale,
+        RgbToSpectrumTable::srgb().lookup(rgb.map(|v| v / scale)),
+    ))
 }
 
 /// Emitted radiance given as linear RGB, at the sample's wavelengths.
