@@ -44,6 +44,7 @@ enum Command {
     #[command(args_override_self = true)]
     Render(RenderArgs),
     /// Print the ray tree of one pixel: every ray traced for it and why each branch ended.
+    #[command(args_override_self = true)]
     TracePixel(TracePixelArgs),
     /// Measure an acceleration structure on a rays file: build time, memory, Mrays/s.
     Bench(bench::BenchArgs),
@@ -244,6 +245,11 @@ struct TracePixelArgs {
     /// Print JSON instead of an indented tree.
     #[arg(long)]
     json: bool,
+    /// Which of the pixel's samples to trace, counted from 0 (default 0), or `all`: the
+    /// tree then holds every sample's rays and the colour is the pixel's. SPPM, adaptive
+    /// subdivision and the SPD corners trace the whole pixel.
+    #[arg(long)]
+    sample: Option<trace::SampleArg>,
     #[command(flatten)]
     view: ViewArgs,
 }

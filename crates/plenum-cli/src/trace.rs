@@ -2,8 +2,10 @@
 
 use crate::{load, settings, TracePixelArgs};
 use plenum_core::accel::AccelKind;
+use plenum_core::integrator::IntegratorKind;
 use plenum_core::integrator::{RayNode, RayTree};
-use plenum_core::render::trace_pixel;
+use plenum_core::render::{samples_per_pixel, trace_pixel, trace_sample, RenderSettings};
+use plenum_core::scene::Scene;
 use plenum_core::{Color, Vec3};
 use serde_json::{json, Value};
 use std::fmt::Write as _;
@@ -31,15 +33,31 @@ pub fn run(args: TracePixelArgs) -> ExitCode {
         return ExitCode::from(2);
     }
     let (x, y) = (args.x as u32, args.y as u32);
-    let (tree, color) = trace_pixel(&loaded.scene, &settings, x, y);
+    let traced = match trace(&loaded.scene, &settings, (x, y), args.sample) {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
     let mut out = String::new();
     if args.json {
-        out = serde_json::to_string_pretty(&tree_json((x, y), &tree, color)).unwrap_or_default();
+        out = serde_json::to_string_pretty(&tree_json(&traced)).unwrap_or_default();
         out.push('\n');
     } else {
-        let _ = writeln!(out, "pixel ({x}, {y}): colour {}", fmt_color(color));
+        let _ = writeln!(
+            out,
+            "pixel ({x}, {y}), {}: colour {}",
+            traced.which(),
+            fmt_color(traced.color)
+        );
+        let tree = &traced.tree;
+        for l in &tree.wavelengths {
+            let nm: Vec<String> = l.iter().map(|v| format!("{v:.1}")).collect();
+            let _ = writeln!(out, "wavelengths {} nm", nm.join(", "));
+        }
         for root in (0..tree.nodes.len()).filter(|&i| tree.nodes[i].parent.is_none()) {
-            print_node(&mut out, &tree, root, 0);
+            print_node(&mut out, tree, root, 0);
         }
     }
     // A reader that stops early (`| head`) is not an error.
@@ -47,12 +65,108 @@ pub fn run(args: TracePixelArgs) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-/// The ray tree of pixel (x, y) and its colour, as `--json` prints it.
-pub(crate) fn tree_json((x, y): (u32, u32), tree: &RayTree, color: Color) -> Value {
+/// `--sample`: one sample of the pixel by its index, or all of them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum SampleArg {
+    Index(u32),
+    All,
+}
+
+impl std::str::FromStr for SampleArg {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "all" => Ok(SampleArg::All),
+            _ => s.parse().map(SampleArg::Index).map_err(|_| {
+                format!("expected a sample index (a whole number from 0) or `all`, not `{s}`")
+            }),
+        }
+    }
+}
+
+/// A pixel's ray tree: of one sample, or of all of them.
+pub(crate) struct Traced {
+    pub pixel: (u32, u32),
+    pub tree: RayTree,
+    /// The sample's colour (before the filter weighs it), or the pixel's.
+    pub color: Color,
+    /// The sample traced, of how many; `None`: all of them.
+    pub sample: Option<(u32, u32)>,
+    /// Why all of the pixel was traced where one sample was asked for.
+    pub whole: Option<&'static str>,
+}
+
+impl Traced {
+    /// "sample K of N", or what else was traced.
+    pub fn which(&self) -> String {
+        match (self.sample, self.whole) {
+            (Some((k, n)), _) => format!("sample {k} of {n} (counted from 0)"),
+            (None, Some(why)) => format!("all its samples ({why})"),
+            (None, None) => "all its samples".to_string(),
+        }
+    }
+}
+
+/// Traces sample `sample` of pixel (x, y) (the first if `None`), or all its samples where
+/// asked or where the method's pixel is not a list of samples; an index beyond them is an
+/// error.
+pub(crate) fn trace(
+    scene: &Scene,
+    settings: &RenderSettings,
+    (x, y): (u32, u32),
+    sample: Option<SampleArg>,
+) -> Result<Traced, String> {
+    let spp = samples_per_pixel(settings);
+    let whole = |why| {
+        let (tree, color) = trace_pixel(scene, settings, x, y);
+        Ok(Traced {
+            pixel: (x, y),
+            tree,
+            color,
+            sample: None,
+            whole: why,
+        })
+    };
+    let k = match (sample, spp) {
+        (Some(SampleArg::All), _) => return whole(None),
+        (_, None) => {
+            let why = if settings.integrator.kind == IntegratorKind::Sppm {
+                "SPPM's pixel is its iterations' photon statistics, not a list of samples"
+            } else {
+                "this pixel is its corner rays, not a list of samples"
+            };
+            return whole(Some(why));
+        }
+        (Some(SampleArg::Index(k)), _) => k,
+        (None, _) => 0,
+    };
+    let n = spp.unwrap_or(0);
+    match trace_sample(scene, settings, x, y, k) {
+        Some((tree, color)) => Ok(Traced {
+            pixel: (x, y),
+            tree,
+            color,
+            sample: Some((k, n)),
+            whole: None,
+        }),
+        None => Err(format!(
+            "--sample {k} is beyond the pixel's {n} samples: give 0 to {}, or all",
+            n.saturating_sub(1)
+        )),
+    }
+}
+
+/// A traced pixel as `--json` prints it.
+pub(crate) fn tree_json(t: &Traced) -> Value {
+    let (x, y) = t.pixel;
     json!({
         "pixel": [x, y],
-        "color": rgb(color),
-        "rays": tree.nodes.iter().enumerate().map(|(i, n)| node_json(i, n)).collect::<Vec<_>>(),
+        "sample": t.sample.map(|(k, _)| k),
+        "samples": t.sample.map(|(_, n)| n),
+        "traced": t.which(),
+        "color": rgb(t.color),
+        "wavelengths": t.tree.wavelengths,
+        "rays": t.tree.nodes.iter().enumerate().map(|(i, n)| node_json(i, n)).collect::<Vec<_>>(),
     })
 }
 
@@ -98,6 +212,18 @@ fn node_json(id: usize, n: &RayNode) -> Value {
                 "distance": p.distance,
             })).collect::<Vec<_>>(),
         });
+    }
+    if let Some(o) = &n.optics {
+        v["optics"] = json!({
+            "incidence_degrees": o.incidence,
+            "eta": o.eta.map(|(a, b)| [a, b]),
+            "refraction_degrees": o.refraction,
+            "critical_degrees": o.critical,
+            "fresnel_reflectance": o.fresnel,
+        });
+    }
+    if !n.lights_behind.is_empty() {
+        v["lights_behind"] = json!(n.lights_behind);
     }
     if let Some(s) = &n.shadow {
         v["light"] = json!(s.light);
@@ -187,6 +313,28 @@ fn print_node(out: &mut String, tree: &RayTree, id: usize, indent: usize) {
             let more = g.photons.len() - PHOTONS_LISTED;
             let _ = writeln!(out, "{pad}    … {more} more (--json lists them all)");
         }
+    }
+    if let Some(o) = &n.optics {
+        let mut line = format!("{pad}  angle of incidence {:.2}°", o.incidence);
+        if let Some((a, b)) = o.eta {
+            let _ = write!(line, "; η {a:.4} → {b:.4}");
+        }
+        if let Some(t) = o.refraction {
+            let _ = write!(line, ", refracted at {t:.2}°");
+        }
+        if let Some(c) = o.critical {
+            let _ = write!(line, ", critical angle {c:.2}°");
+        }
+        if let Some(f) = o.fresnel {
+            let _ = write!(line, "; Fresnel reflectance {f:.4}");
+        }
+        let _ = writeln!(out, "{line}");
+    }
+    for light in &n.lights_behind {
+        let _ = writeln!(
+            out,
+            "{pad}  light \"{light}\" is behind the surface: no shadow ray"
+        );
     }
     if n.total_internal_reflection {
         let _ = writeln!(

@@ -145,6 +145,104 @@ fn trace_pixel_shows_the_ray_tree() {
     );
 }
 
+/// `--sample K` traces one sample, and the samples' colours average to the pixel's
+/// (`--sample all`, box filter); an index beyond them is refused. The tree shows the optics
+/// of each hit, the lights behind a surface, and why a branch of Whitted's was not traced
+/// (the other going on); local illumination says it does not recurse; SPPM traces its pixel.
+#[test]
+fn trace_pixel_traces_one_sample_and_shows_why() {
+    let base = [
+        "trace-pixel",
+        "-",
+        "32",
+        "24",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--spp",
+        "4",
+    ];
+    let json = |extra: &[&str]| -> serde_json::Value {
+        let o = plenum()
+            .args(base)
+            .args(extra)
+            .arg("--json")
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let color = |v: &serde_json::Value| -> Vec<f64> {
+        v["color"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_f64().unwrap())
+            .collect()
+    };
+    let first = json(&[]);
+    assert_eq!(first["sample"], 0);
+    assert_eq!(first["samples"], 4);
+    let mut mean = vec![0.0; 3];
+    for k in 0..4 {
+        let doc = json(&["--sample", &k.to_string()]);
+        assert_eq!(doc["sample"], k);
+        // One camera ray per sample.
+        let rays = doc["rays"].as_array().unwrap();
+        assert_eq!(rays.iter().filter(|r| r["kind"] == "camera").count(), 1);
+        for (m, c) in mean.iter_mut().zip(color(&doc)) {
+            *m += c / 4.0;
+        }
+    }
+    let all = json(&["--sample", "all"]);
+    assert!(all["sample"].is_null());
+    for (m, c) in mean.iter().zip(color(&all)) {
+        assert!(
+            (m - c).abs() < 1e-6,
+            "samples {mean:?} against the pixel {:?}",
+            color(&all)
+        );
+    }
+    for bad in ["4", "-1", "first"] {
+        let o = plenum()
+            .args(base)
+            .args(["--sample", bad])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "--sample {bad}");
+    }
+
+    let text = |extra: &[&str]| {
+        let o = plenum().args(base).args(extra).output().unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let glass = text(&[]);
+    assert!(
+        glass.starts_with("pixel (32, 24), sample 0 of 4"),
+        "{glass}"
+    );
+    for needle in [
+        "angle of incidence",
+        "η 1.0000 → 1.5000, refracted at",
+        "critical angle 41.81°",
+        "Fresnel reflectance",
+        "is behind the surface: no shadow ray",
+    ] {
+        assert!(glass.contains(needle), "no `{needle}` in\n{glass}");
+    }
+    let shallow = text(&["--max-depth", "1"]);
+    assert!(shallow.contains("ray not traced: depth"), "{shallow}");
+    assert!(!shallow.contains("stopped: depth"), "{shallow}");
+    let local = text(&["--integrator", "local"]);
+    assert!(local.contains("no recursion"), "{local}");
+    let path = text(&["--integrator", "path", "--color", "spectral"]);
+    assert_eq!(path.matches("wavelengths ").count(), 1, "{path}");
+    let sppm = text(&["--integrator", "sppm", "--spp", "1"]);
+    assert!(sppm.contains("all its samples (SPPM"), "{sppm}");
+}
+
 /// Each bad scene exits with code 2 and names file:line:column and what was expected.
 #[test]
 fn bad_scenes_give_located_errors() {

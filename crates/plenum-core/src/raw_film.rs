@@ -86,6 +86,14 @@ impl PixelSums {
 
     /// Σ w·L / Σ w; should the weights of a filter with negative lobes cancel out (a few
     /// samples, all unlucky), the plain mean instead of a division by nearly zero.
+    /// The samples' plain mean, without the filter's weights: for one sample, its colour
+    /// (to 2⁻³²).
+    pub fn plain_mean(&self) -> Color {
+        let n = self.count.max(1) as f64;
+        let [r, g, b] = self.plain.map(|s| value(s) / n);
+        Color::new(r, g, b)
+    }
+
     pub fn value(&self) -> Color {
         let w = self.weight as f64;
         if value(self.weight) > 0.25 * self.count as f64 {

@@ -547,6 +547,66 @@ pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> 
     if let Some(method) = whole_image(settings.integrator.kind) {
         return method.trace_pixel(scene, settings, x, y);
     }
+    traced(scene, settings, |integrator, camera, counts, tree| {
+        render_pixel(integrator, camera, settings, x, y, counts, Some(tree))
+    })
+}
+
+/// The samples of a pixel that [`trace_sample`] can pick one of: the sampler's (adaptive
+/// sampling's budget); `None` where a pixel is not a list of samples (SPPM's iterations,
+/// Whitted's adaptive subdivision, the SPD corners).
+pub fn samples_per_pixel(settings: &RenderSettings) -> Option<u32> {
+    if whole_image(settings.integrator.kind).is_some() || settings.corners {
+        return None;
+    }
+    match settings.adaptive {
+        Some(Adaptive::Subdivide { .. }) => None,
+        Some(Adaptive::Variance { max_spp, .. }) => Some(max_spp),
+        None => Some(settings.sampler.samples_per_pixel()),
+    }
+}
+
+/// The ray tree of sample `index` of pixel (x, y), the very sample a render takes there, and
+/// its colour (before the filter weighs it); `None` where [`samples_per_pixel`] is, or
+/// `index` is not below it.
+pub fn trace_sample(
+    scene: &Scene,
+    settings: &RenderSettings,
+    x: u32,
+    y: u32,
+    index: u32,
+) -> Option<(RayTree, Color)> {
+    if index >= samples_per_pixel(settings)? {
+        return None;
+    }
+    Some(traced(
+        scene,
+        settings,
+        |integrator, camera, counts, tree| {
+            let mut sums = PixelSums::default();
+            let range = index..index + 1;
+            sample_pixel(
+                integrator,
+                camera,
+                settings,
+                (x, y),
+                range,
+                &mut sums,
+                counts,
+                Some(tree),
+            );
+            sums.plain_mean()
+        },
+    ))
+}
+
+/// Runs `f` with the render's integrator and camera (as `render` makes them) and a tree to
+/// record in.
+fn traced(
+    scene: &Scene,
+    settings: &RenderSettings,
+    f: impl FnOnce(&Integrator, &Camera, &mut RayCounts, &mut RayTree) -> Color,
+) -> (RayTree, Color) {
     let splats =
         SplatBuffer::new(settings.width, settings.height, 1.0).with_filter(&settings.filter);
     let camera =
@@ -561,15 +621,7 @@ pub fn trace_pixel(scene: &Scene, settings: &RenderSettings, x: u32, y: u32) -> 
     );
     let mut tree = RayTree::default();
     let mut counts = RayCounts::default();
-    let c = render_pixel(
-        &integrator,
-        &camera,
-        settings,
-        x,
-        y,
-        &mut counts,
-        Some(&mut tree),
-    );
+    let c = f(&integrator, &camera, &mut counts, &mut tree);
     (tree, c)
 }
 

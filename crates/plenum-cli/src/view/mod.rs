@@ -11,14 +11,14 @@
 
 mod http;
 
-use crate::trace::tree_json;
+use crate::trace::{trace, tree_json, SampleArg};
 use crate::{named, render_settings, whole, Cli, Command, ViewArgs, MAX_THREADS};
 use http::{Request, Response};
 use plenum_core::accel::AccelKind;
 use plenum_core::camera::Camera;
 use plenum_core::integrator::{whole_image, ColorMode, IntegratorKind, RayCounts};
 use plenum_core::raw_film::RawFilm;
-use plenum_core::render::{new_film, render_film, trace_pixel};
+use plenum_core::render::{new_film, render_film};
 use plenum_core::render::{RenderControl, RenderSettings};
 use plenum_core::sampling::FilterKind;
 use plenum_core::scene::Scene;
@@ -475,17 +475,17 @@ impl Server {
         }
     }
 
-    /// The ray tree of pixel (x, y) of the render under way, each ray with the segment
-    /// it draws over the image.
+    /// The ray tree of pixel (x, y) of the render under way (`sample=K`, default 0, or
+    /// `all`, as `trace-pixel --sample`), each ray with the segment it draws over the image.
     fn trace(&self, r: &Request) -> Response {
         let Some(job) = self.state().job.clone() else {
             return Response::error(409, "no render yet");
         };
         let (w, h) = (job.settings.width, job.settings.height);
         let coordinate = |key: &str, size: u32| -> Result<u32, String> {
-            let v = r
-                .get(key)
-                .ok_or_else(|| format!("missing `{key}`: expected /api/trace?x=X&y=Y"))?;
+            let v = r.get(key).ok_or_else(|| {
+                format!("missing `{key}`: expected /api/trace?x=X&y=Y[&sample=K]")
+            })?;
             v.parse::<u32>().ok().filter(|&n| n < size).ok_or_else(|| {
                 format!(
                     "`{key}` must be a whole number from 0 to {}, not `{v}`",
@@ -497,8 +497,16 @@ impl Server {
             (Ok(x), Ok(y)) => (x, y),
             (Err(e), _) | (_, Err(e)) => return Response::error(400, &e),
         };
-        let (tree, color) = trace_pixel(&job.scene, &job.settings, x, y);
-        let mut doc = tree_json((x, y), &tree, color);
+        let sample = match r.get("sample").map(str::parse::<SampleArg>).transpose() {
+            Ok(s) => s,
+            Err(e) => return Response::error(400, &format!("`sample`: {e}")),
+        };
+        let traced = match trace(&job.scene, &job.settings, (x, y), sample) {
+            Ok(t) => t,
+            Err(e) => return Response::error(400, &e),
+        };
+        let tree = &traced.tree;
+        let mut doc = tree_json(&traced);
         let camera = Camera::new(&job.scene.camera, w, h);
         // A ray that escaped is drawn far past the scene.
         let far = 4.0 * job.scene.geometry.radius().max(1e-3);

@@ -27,7 +27,7 @@ pub use medium::MediumStack;
 pub use path::PathTracer;
 pub use photon::PhotonMapper;
 pub use ray_tree::{
-    FoundPhoton, PhotonGather, RayKind, RayNode, RayTree, ShadowInfo, Stop, Strategy,
+    FoundPhoton, Optics, PhotonGather, RayKind, RayNode, RayTree, ShadowInfo, Stop, Strategy,
 };
 pub use whitted::{Whitted, WhittedConfig};
 
@@ -69,15 +69,19 @@ pub(crate) fn sample_wavelengths(
 }
 
 /// A physically based method's estimate `li` at the wavelengths the stream draws, as a
-/// colour.
+/// colour; a tree notes the wavelengths.
 #[inline]
 fn spectral(
     color: ColorMode,
     stream: &mut SampleStream,
-    li: impl FnOnce(&mut SampledWavelengths, &mut SampleStream) -> SampledSpectrum,
+    mut tree: Option<&mut RayTree>,
+    li: impl FnOnce(&mut SampledWavelengths, &mut SampleStream, Option<&mut RayTree>) -> SampledSpectrum,
 ) -> Color {
     let mut wl = sample_wavelengths(color, stream);
-    let l = li(&mut wl, stream);
+    if let (Some(t), ColorMode::Spectral) = (tree.as_deref_mut(), color) {
+        t.wavelengths.push(*wl.lambda());
+    }
+    let l = li(&mut wl, stream, tree);
     rgb(l, &wl)
 }
 
@@ -177,20 +181,26 @@ impl<'a> Integrator<'a> {
             }
             Integrator::Path(p) => {
                 counts.camera += 1;
-                spectral(p.color, stream, |wl, s| p.li(ray, wl, s, counts, tree))
+                spectral(p.color, stream, tree, |wl, s, t| {
+                    p.li(ray, wl, s, counts, t)
+                })
             }
             // A light path per sample; what reaches the camera is splatted.
-            Integrator::Light(l) => spectral(l.color, stream, |wl, s| {
-                l.light_path(ray.time, wl, s, counts, tree);
+            Integrator::Light(l) => spectral(l.color, stream, tree, |wl, s, t| {
+                l.light_path(ray.time, wl, s, counts, t);
                 SampledSpectrum::ZERO
             }),
             Integrator::Bdpt(b) => {
                 counts.camera += 1;
-                spectral(b.color, stream, |wl, s| b.li(ray, wl, s, counts, tree))
+                spectral(b.color, stream, tree, |wl, s, t| {
+                    b.li(ray, wl, s, counts, t)
+                })
             }
             Integrator::Photon(p) => {
                 counts.camera += 1;
-                spectral(p.color, stream, |wl, s| p.li(ray, wl, s, counts, tree))
+                spectral(p.color, stream, tree, |wl, s, t| {
+                    p.li(ray, wl, s, counts, t)
+                })
             }
         };
         if !(c.r.is_finite() && c.g.is_finite() && c.b.is_finite()) {

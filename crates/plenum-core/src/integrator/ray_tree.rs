@@ -43,6 +43,14 @@ pub enum Stop {
     Weight,
     /// The surface neither reflects nor transmits: a leaf of the tree.
     Opaque,
+    /// Local illumination and Appel's method end at the first hit: they do not recurse.
+    NoRecursion,
+    /// One secondary ray of Whitted's (reflected or refracted) was due but not traced, as
+    /// the maximum depth was reached; the other may go on.
+    SkippedAtDepth(RayKind),
+    /// One secondary ray of Whitted's was not traced, its weight in the pixel being below
+    /// the threshold; the other may go on.
+    SkippedForWeight(RayKind),
 }
 
 impl Stop {
@@ -52,8 +60,29 @@ impl Stop {
             Stop::Depth => "depth",
             Stop::Weight => "weight",
             Stop::Opaque => "no reflection or transmission",
+            Stop::NoRecursion => "no recursion (this method stops at the first hit)",
+            Stop::SkippedAtDepth(RayKind::Refracted) => "refracted ray not traced: depth",
+            Stop::SkippedAtDepth(_) => "reflected ray not traced: depth",
+            Stop::SkippedForWeight(RayKind::Refracted) => "refracted ray not traced: weight",
+            Stop::SkippedForWeight(_) => "reflected ray not traced: weight",
         }
     }
+}
+
+/// The optics at a hit of Whitted's: what the ray met and how it splits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Optics {
+    /// Angle of incidence to the shading normal, degrees.
+    pub incidence: f64,
+    /// Indices of refraction on the ray's side and beyond, where the surface transmits.
+    pub eta: Option<(f64, f64)>,
+    /// Angle of refraction, degrees; `None` under total internal reflection or where the
+    /// surface does not transmit.
+    pub refraction: Option<f64>,
+    /// The critical angle, degrees, where light goes from denser to thinner.
+    pub critical: Option<f64>,
+    /// Fresnel reflectance at this angle, where the material uses it.
+    pub fresnel: Option<f64>,
 }
 
 /// What a shadow ray found on its way to a light.
@@ -93,6 +122,10 @@ pub struct RayNode {
     pub strategy: Option<Strategy>,
     /// For photon mapping and SPPM: the photons a density estimate at this hit found.
     pub photons: Option<PhotonGather>,
+    /// Whitted's: the angles and Fresnel reflectance at this hit.
+    pub optics: Option<Optics>,
+    /// Whitted's: lights behind the surface at this hit, which get no shadow ray.
+    pub lights_behind: Vec<String>,
 }
 
 /// The photons found around one point by a density estimate, and what they give.
@@ -155,6 +188,8 @@ impl RayNode {
             shadow: None,
             strategy: None,
             photons: None,
+            optics: None,
+            lights_behind: Vec::new(),
         }
     }
 }
@@ -163,6 +198,8 @@ impl RayNode {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RayTree {
     pub nodes: Vec<RayNode>,
+    /// In spectral mode, the wavelengths (nm) of each camera sample traced, in order.
+    pub wavelengths: Vec<[f64; 4]>,
 }
 
 impl RayTree {

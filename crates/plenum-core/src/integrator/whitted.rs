@@ -16,7 +16,7 @@
 //! the pixel sample's stream, so the sampler stratifies them across the pixel's samples.
 
 use super::{
-    IntegratorConfig, IntegratorKind, MediumStack, RayCounts, RayKind, RayNode, RayTree,
+    IntegratorConfig, IntegratorKind, MediumStack, Optics, RayCounts, RayKind, RayNode, RayTree,
     ShadowInfo, Stop,
 };
 use crate::accel::Coherence;
@@ -36,6 +36,8 @@ pub struct WhittedConfig {
     pub min_weight: f64,
     /// Shadow rays decide S_L; without them every light is seen (local illumination).
     pub shadows: bool,
+    /// Whitted's method recurses; local illumination and Appel's stop at the first hit.
+    pub recursive: bool,
 }
 
 impl Default for WhittedConfig {
@@ -53,6 +55,7 @@ impl IntegratorConfig {
             max_depth: if recursive { self.max_depth } else { 0 },
             min_weight: self.min_weight,
             shadows: self.kind != IntegratorKind::Local,
+            recursive,
         }
     }
 }
@@ -137,6 +140,17 @@ impl<'a> Whitted<'a> {
         // Normals on the side the ray arrives from.
         let n = if entering { it.n } else { -it.n };
         let ns = it.shading_n.face_forward(n);
+        if b.tree.is_some() {
+            // The angle at every hit; where the ray splits, the rest is added below.
+            let optics = Optics {
+                incidence: degrees(v.dot(ns)),
+                eta: None,
+                refraction: None,
+                critical: None,
+                fresnel: None,
+            };
+            record(&mut b, node, |n| n.optics = Some(optics));
+        }
 
         // Local illumination: emission, ambient, and Phong from every light. An area light's
         // surface shows its light's radiance on the side it emits to, in place of any k_e
@@ -177,6 +191,13 @@ impl<'a> Whitted<'a> {
                 };
                 let cos = ns.dot(inc.wi);
                 if cos <= 0.0 || n.dot(inc.wi) <= 0.0 {
+                    // Said once per light, not per shadow-ray cell.
+                    let name = &self.scene.lights.names[li as usize];
+                    record(&mut b, node, |n| {
+                        if !n.lights_behind.contains(name) {
+                            n.lights_behind.push(name.clone());
+                        }
+                    });
                     continue;
                 }
                 let s = if self.config.shadows {
@@ -247,14 +268,27 @@ impl<'a> Whitted<'a> {
         if total_internal_reflection {
             record(&mut b, node, |n| n.total_internal_reflection = true);
         }
+        let mut fresnel = None;
         if k.fresnel {
             // F = 1 under total internal reflection: everything goes to the reflected ray.
             let f = fresnel_dielectric(v.dot(ns).max(0.0), eta_i, eta_t);
+            fresnel = Some(f);
             kr = kr * f;
             kt = kt * (1.0 - f);
         } else if total_internal_reflection {
             kr += kt;
             kt = Color::BLACK;
+        }
+        if b.tree.is_some() {
+            let transmits = !k.transmissive.is_black() && solid;
+            let optics = Optics {
+                incidence: degrees(v.dot(ns)),
+                eta: transmits.then_some((eta_i, eta_t)),
+                refraction: refracted.filter(|_| transmits).map(|t| degrees(t.dot(-ns))),
+                critical: (transmits && eta_i > eta_t).then(|| (eta_t / eta_i).asin().to_degrees()),
+                fresnel,
+            };
+            record(&mut b, node, |n| n.optics = Some(optics));
         }
         let secondary = [
             (RayKind::Reflected, kr, Some(reflected), b.media),
@@ -275,12 +309,21 @@ impl<'a> Whitted<'a> {
                 direction = lobe;
             }
             if b.depth >= self.config.max_depth {
-                record(&mut b, node, |n| n.stops.push(Stop::Depth));
+                let stop = if self.config.recursive {
+                    Stop::SkippedAtDepth(kind)
+                } else {
+                    Stop::NoRecursion
+                };
+                record(&mut b, node, |n| {
+                    if !n.stops.contains(&stop) {
+                        n.stops.push(stop)
+                    }
+                });
                 continue;
             }
             let weight = b.weight * coefficient;
             if weight.max_component() < self.config.min_weight {
-                record(&mut b, node, |n| n.stops.push(Stop::Weight));
+                record(&mut b, node, |n| n.stops.push(Stop::SkippedForWeight(kind)));
                 continue;
             }
             match kind {
@@ -374,6 +417,11 @@ impl<'a> Whitted<'a> {
         }
         s
     }
+}
+
+/// The angle, in degrees, whose cosine is `cos` (clamped to [−1, 1]).
+fn degrees(cos: f64) -> f64 {
+    cos.clamp(-1.0, 1.0).acos().to_degrees()
 }
 
 fn record(b: &mut Branch<'_, '_>, node: Option<usize>, f: impl FnOnce(&mut RayNode)) {
