@@ -59,6 +59,23 @@ pub fn run(args: TracePixelArgs) -> ExitCode {
         for root in (0..tree.nodes.len()).filter(|&i| tree.nodes[i].parent.is_none()) {
             print_node(&mut out, tree, root, 0);
         }
+        // BDPT: what the listed strategies add up to, here and elsewhere.
+        let strategies = tree.nodes.iter().filter_map(|n| Some((n, n.strategy?)));
+        let (mut here, mut elsewhere, mut any) = (Color::BLACK, 0, false);
+        for (n, s) in strategies {
+            any = true;
+            match s.splat {
+                None => here += n.color,
+                Some(_) => elsewhere += 1,
+            }
+        }
+        if any {
+            let _ = writeln!(
+                out,
+                "the strategies of this sample add {} to its pixel; {elsewhere} more land in other pixels (t = 1)",
+                fmt_color(here)
+            );
+        }
     }
     // A reader that stops early (`| head`) is not an error.
     let _ = std::io::stdout().lock().write_all(out.as_bytes());
@@ -198,7 +215,7 @@ fn node_json(id: usize, n: &RayNode) -> Value {
         "total_internal_reflection": n.total_internal_reflection,
     });
     if let Some(s) = &n.strategy {
-        v["strategy"] = json!({"s": s.s, "t": s.t, "mis_weight": s.mis_weight, "unweighted": rgb(s.unweighted)});
+        v["strategy"] = json!({"s": s.s, "t": s.t, "mis_weight": s.mis_weight, "unweighted": rgb(s.unweighted), "splat": s.splat});
     }
     if let Some(g) = &n.photons {
         v["photons"] = json!({
@@ -281,11 +298,19 @@ fn print_node(out: &mut String, tree: &RayTree, id: usize, indent: usize) {
     if let Some(s) = &n.strategy {
         let _ = writeln!(
             out,
-            "{pad}  strategy s = {}, t = {}: unweighted {}, MIS weight {:.4}",
+            "{pad}  strategy s = {}, t = {}: unweighted {}, MIS weight {:.4}{}",
             s.s,
             s.t,
             fmt_color(s.unweighted),
-            s.mis_weight
+            s.mis_weight,
+            match s.splat {
+                Some([x, y]) => format!(
+                    "; lands at raster ({x:.2}, {y:.2}), pixel ({}, {}), not in this sample",
+                    x.floor(),
+                    y.floor()
+                ),
+                None => String::new(),
+            }
         );
     }
     if let Some(g) = &n.photons {

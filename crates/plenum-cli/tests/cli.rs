@@ -239,6 +239,51 @@ fn trace_pixel_traces_one_sample_and_shows_why() {
     assert!(local.contains("no recursion"), "{local}");
     let path = text(&["--integrator", "path", "--color", "spectral"]);
     assert_eq!(path.matches("wavelengths ").count(), 1, "{path}");
+    // BDPT's tree adds up: the strategies that stay in the pixel sum to the sample's colour
+    // (the built-in scene has no Phong emission); every surface a subpath hit is named.
+    let mut refracted = false;
+    for k in 0..4 {
+        let doc = json(&["--integrator", "bdpt", "--sample", &k.to_string()]);
+        let rays = doc["rays"].as_array().unwrap();
+        let mut sum = [0.0; 3];
+        for r in rays
+            .iter()
+            .filter(|r| r["strategy"]["splat"].is_null() && r["strategy"].is_object())
+        {
+            for (s, c) in sum.iter_mut().zip(r["color"].as_array().unwrap()) {
+                *s += c.as_f64().unwrap();
+            }
+        }
+        for (s, c) in sum.iter().zip(color(&doc)) {
+            assert!(
+                (s - c).abs() <= 1e-9 + 1e-9 * c.abs(),
+                "sample {k}: {sum:?} against {:?}",
+                color(&doc)
+            );
+        }
+        let camera = rays.iter().find(|r| r["kind"] == "camera").unwrap();
+        assert_eq!(camera["object"], "glass sphere");
+        refracted |= rays.iter().any(|r| r["kind"] == "refracted");
+    }
+    assert!(refracted, "no sample's camera subpath went into the glass");
+    // In the Cornell box, light subpaths reach the camera directly (t = 1) and land in
+    // other pixels: the tree says where.
+    let cbox = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
+    let o = plenum()
+        .arg("trace-pixel")
+        .arg(&cbox)
+        .args([
+            "64", "64", "--width", "128", "--height", "128", "--spp", "8",
+        ])
+        .args(["--integrator", "bdpt", "--sample", "2"])
+        .output()
+        .unwrap();
+    let t = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        t.contains("s = 2, t = 1") && t.contains("lands at raster"),
+        "{t}"
+    );
+    assert!(t.contains("more land in other pixels (t = 1)"), "{t}");
     let sppm = text(&["--integrator", "sppm", "--spp", "1"]);
     assert!(sppm.contains("all its samples (SPPM"), "{sppm}");
 }

@@ -20,7 +20,7 @@
 //! background, a Phong material's k_e) is found by s = 0 alone and so takes weight 1.
 
 use super::light_path::{adjoint_cosine_of, leave_light, start_light_path, LightStart};
-use super::{rgb, IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Strategy};
+use super::{rgb, IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Stop, Strategy};
 use crate::accel::Coherence;
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
@@ -111,6 +111,8 @@ struct Vertex {
     /// Emission of a camera path's surface that no light stands for (a Phong k_e).
     ke: SampledSpectrum,
     time: f64,
+    /// The primitive a surface vertex lies on, for the ray tree.
+    primitive: Option<u32>,
 }
 
 impl Vertex {
@@ -132,6 +134,7 @@ impl Vertex {
             pdf_rev: 0.0,
             ke: SampledSpectrum::ZERO,
             time: 0.0,
+            primitive: None,
         }
     }
 
@@ -275,8 +278,8 @@ impl<'a> BidirectionalPathTracer<'a> {
         let max_surface = self.max_depth as usize + 1;
         self.camera_subpath(ray, max_surface + 2, wl, stream, counts, camera_path);
         self.light_subpath(ray.time, max_surface, wl, stream, counts, light_path);
-        record_subpath(&mut tree, camera_path, RayKind::Camera, wl);
-        record_subpath(&mut tree, light_path, RayKind::Light, wl);
+        record_subpath(&mut tree, self.scene, camera_path, RayKind::Camera, wl);
+        record_subpath(&mut tree, self.scene, light_path, RayKind::Light, wl);
 
         let mut l = SampledSpectrum::ZERO;
         // Emission no light stands for, Phong k_e, by s = 0 alone (the background is a
@@ -309,13 +312,20 @@ impl<'a> BidirectionalPathTracer<'a> {
                 }
                 if let Some(tr) = tree.as_deref_mut() {
                     let end = &camera_path[t - 1];
-                    let from = light_path.get(s.wrapping_sub(1)).map_or(end.p, |v| v.p);
+                    // s = 0: the camera path found a light itself, along its last ray.
+                    let (from, direction) = match s {
+                        0 => {
+                            let v = &camera_path[t - 2];
+                            (v.p, v.toward(end))
+                        }
+                        _ => (light_path[s - 1].p, end.p - light_path[s - 1].p),
+                    };
                     let mut node = RayNode::new(
                         None,
                         RayKind::Connection,
                         (s + t - 2) as u32,
                         from,
-                        end.p - from,
+                        direction,
                         Color::gray(weight),
                     );
                     node.strategy = Some(Strategy {
@@ -323,6 +333,7 @@ impl<'a> BidirectionalPathTracer<'a> {
                         t: t as u32,
                         mis_weight: weight,
                         unweighted: rgb(c, wl),
+                        splat: splat_at,
                     });
                     node.color = rgb(c * weight, wl);
                     tr.push(node);
@@ -491,6 +502,7 @@ impl<'a> BidirectionalPathTracer<'a> {
                 pdf_rev: 0.0,
                 ke: SampledSpectrum::ZERO,
                 time: ray.time,
+                primitive: Some(prim),
             };
             if mode == TransportMode::Radiance && v.light.is_none() {
                 if let Some(ke) = scene.phong_emission(&it, wl) {
@@ -901,9 +913,10 @@ impl<'a> BidirectionalPathTracer<'a> {
     }
 }
 
-/// The subpath's rays in the ray tree, each with its throughput.
+/// The subpath's rays in the ray tree, each with its throughput and what it hit.
 fn record_subpath(
     tree: &mut Option<&mut RayTree>,
+    scene: &Scene,
     path: &[Vertex],
     kind: RayKind,
     wl: &SampledWavelengths,
@@ -915,14 +928,22 @@ fn record_subpath(
     for (i, pair) in path.windows(2).enumerate() {
         let (a, b) = (&pair[0], &pair[1]);
         let d = a.toward(b);
-        // The camera subpath's later rays are its bounces; the light subpath's all light.
-        let k = if i > 0 && kind == RayKind::Camera {
-            RayKind::Reflected
-        } else {
-            kind
+        // The camera subpath's later rays are its bounces, reflected or refracted as they
+        // leave on the side they came from or the other; the light subpath's are all light.
+        let k = match kind {
+            RayKind::Camera if i > 0 && a.n.dot(d) * a.n.dot(a.wo) < 0.0 => RayKind::Refracted,
+            RayKind::Camera if i > 0 => RayKind::Reflected,
+            _ => kind,
         };
         let mut node = RayNode::new(parent, k, i as u32, a.p, d, rgb(b.beta, wl));
         node.distance = (!b.infinite).then(|| (b.p - a.p).length());
+        if let Some(prim) = b.primitive {
+            node.object = Some(scene.geometry.names[prim as usize].clone());
+            let m = scene.geometry.primitives[prim as usize].material as usize;
+            node.material = Some(scene.materials.names[m].clone());
+        } else if b.infinite {
+            node.stops.push(Stop::Miss);
+        }
         parent = Some(t.push(node));
     }
 }

@@ -161,6 +161,9 @@ pub struct Strategy {
     pub mis_weight: f64,
     /// Its contribution before weighting, linear sRGB.
     pub unweighted: Color,
+    /// Where a strategy of one camera vertex (t = 1) lands: a raster point, often in
+    /// another pixel; `None`: this pixel's own sample.
+    pub splat: Option<[f64; 2]>,
 }
 
 impl RayNode {
