@@ -23,3 +23,16 @@ render glass glass
 render metals metals
 render rough-metals rough-metals
 render prism prism
+
+# The page of `plenum view` (README), with the ray tree of the glass sphere's middle pixel,
+# by headless Chromium (Debian: chromium).
+log=$(mktemp)
+"$plenum" view --width 320 --height 240 --spp 16 > "$log" &
+view=$!
+trap 'kill $view 2> /dev/null; rm -f "$log"' EXIT
+until grep -q http "$log"; do sleep 0.1; done
+address=$(grep -o 'http://[^ ]*' "$log")
+echo "plenum view -> docs/view.png" >&2
+chromium --headless --no-sandbox --disable-gpu --disable-dev-shm-usage --hide-scrollbars \
+    --window-size=1280,760 --virtual-time-budget=20000 \
+    --screenshot="$PWD/docs/view.png" "${address}#trace=160,120" 2> /dev/null
