@@ -311,6 +311,16 @@ impl Camera {
             + f.up * (self.half_height - y * self.pixel_size)
     }
 
+    /// The image's size in pixels.
+    pub fn raster_size(&self) -> (f64, f64) {
+        (self.width, self.height)
+    }
+
+    /// The lens centre at time 0.
+    pub fn position(&self) -> Vec3 {
+        self.frame_at(0.0).position
+    }
+
     /// The world segment from `a` to `b` as the camera sees it (at time 0, from the lens
     /// centre): its ends in raster coordinates, inside the image or not, after cutting off
     /// what lies behind the camera; `None` where all of it does. For drawing rays over the

@@ -227,7 +227,7 @@ impl<'a> BidirectionalPathTracer<'a> {
         splats: &'a SplatBuffer,
         strategies: Option<&'a StrategyImages>,
     ) -> Self {
-        let (center, radius) = scene.geometry.bounding_sphere();
+        let (center, radius) = scene.geometry.entry_sphere(camera);
         BidirectionalPathTracer {
             scene,
             camera,

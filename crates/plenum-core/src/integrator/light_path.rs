@@ -9,6 +9,7 @@
 
 use super::{RayCounts, RayKind, RayNode, RayTree};
 use crate::bxdf::{Bsdf, TransportMode};
+use crate::camera::Camera;
 use crate::light::EmissionSample;
 use crate::material::rgb_radiance;
 use crate::math::{offset_ray_origin, Ray, Vec3};
@@ -128,8 +129,10 @@ pub(super) struct LightPaths<'a> {
 }
 
 impl<'a> LightPaths<'a> {
-    pub fn new(scene: &'a Scene, config: &IntegratorConfig) -> Self {
-        let (center, radius) = scene.geometry.bounding_sphere();
+    /// Light paths of `scene` for a render through `camera` (which sets where light from
+    /// infinity enters: [`crate::scene::Geometry::entry_sphere`]).
+    pub fn new(scene: &'a Scene, config: &IntegratorConfig, camera: &Camera) -> Self {
+        let (center, radius) = scene.geometry.entry_sphere(camera);
         LightPaths {
             scene,
             max_depth: config.max_depth,

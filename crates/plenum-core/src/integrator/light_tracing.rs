@@ -49,7 +49,7 @@ impl<'a> LightTracer<'a> {
             scene,
             camera,
             splats,
-            paths: LightPaths::new(scene, config),
+            paths: LightPaths::new(scene, config, camera),
             color: config.color,
         }
     }

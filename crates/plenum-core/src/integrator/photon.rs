@@ -76,7 +76,7 @@ impl<'a> PhotonMapper<'a> {
     /// Traces the photon pass for a render with `seed`.
     pub fn new(scene: &'a Scene, config: &IntegratorConfig, camera: &Camera, seed: u64) -> Self {
         let p = &config.photon;
-        let tracer = PhotonTracer::new(scene, config);
+        let tracer = PhotonTracer::new(scene, config, camera);
         let mut pass_counts = RayCounts::default();
         let global = photon_pass(
             &tracer,

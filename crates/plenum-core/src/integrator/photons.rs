@@ -15,6 +15,7 @@
 pub(super) use super::light_path::Arrival;
 use super::light_path::LightPaths;
 use super::{IntegratorConfig, RayCounts, RayKind};
+use crate::camera::Camera;
 use crate::math::Vec3;
 use crate::sampling::{Rng, SampleStream};
 use crate::scene::{Interaction, Scene};
@@ -26,9 +27,9 @@ pub(super) struct PhotonTracer<'a> {
 }
 
 impl<'a> PhotonTracer<'a> {
-    pub fn new(scene: &'a Scene, config: &IntegratorConfig) -> Self {
+    pub fn new(scene: &'a Scene, config: &IntegratorConfig, camera: &Camera) -> Self {
         PhotonTracer {
-            paths: LightPaths::new(scene, config),
+            paths: LightPaths::new(scene, config, camera),
         }
     }
 

@@ -155,7 +155,7 @@ impl WholeImage for Sppm {
             .expect("an SPPM film, from Sppm::new_film");
         let photons = state.photons_per_iteration;
         let alpha = config.photon.alpha;
-        let tracer = PhotonTracer::new(scene, config);
+        let tracer = PhotonTracer::new(scene, config, &camera);
         let mut pixels: Vec<PixelState> = state
             .pixels
             .iter()
@@ -297,7 +297,7 @@ impl WholeImage for Sppm {
             return (tree, ld);
         };
         let photons = photons_per_iteration(settings);
-        let tracer = PhotonTracer::new(scene, &settings.integrator);
+        let tracer = PhotonTracer::new(scene, &settings.integrator, &camera);
         let max_depth = settings.integrator.max_depth;
         let chunks: Vec<Vec<(FoundPhoton, Color)>> = (0..photons.div_ceil(CHUNK))
             .into_par_iter()

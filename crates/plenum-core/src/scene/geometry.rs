@@ -3,6 +3,7 @@
 
 use super::primitive::{Interaction, Primitive};
 use crate::accel::{Accel, AccelKind, Coherence, LeafSize};
+use crate::camera::Camera;
 use crate::geometry::{HitRecord, Shape, TriangleMesh};
 use crate::math::{Bounds3, Ray, Vec3};
 use std::sync::Arc;
@@ -210,6 +211,48 @@ impl Geometry {
         (center, self.radius())
     }
 
+    /// Where light from infinity enters the scene for light paths and photons: the sphere
+    /// about everything bounded, widened, where the scene has unbounded primitives (an
+    /// infinite floor or wall), to take in what `camera` sees of them within [`ENTRY_REACH`]
+    /// times (their radius + the camera's distance) of the bounded objects' centre. Without
+    /// that, no light path or
+    /// photon from the sky reaches the part of a floor or wall the camera sees beyond the
+    /// bounded objects.
+    pub fn entry_sphere(&self, camera: &Camera) -> (Vec3, f64) {
+        let (center, radius) = self.bounding_sphere();
+        if self.unbounded.is_empty() {
+            return (center, radius);
+        }
+        let mut b = self.bounds();
+        let reach = ENTRY_REACH * (radius + (camera.position() - center).length());
+        let (w, h) = camera.raster_size();
+        for j in 0..=ENTRY_GRID {
+            for i in 0..=ENTRY_GRID {
+                let (x, y) = (i as f64 / ENTRY_GRID as f64, j as f64 / ENTRY_GRID as f64);
+                let ray = camera.ray(x * w, y * h);
+                let Some((prim, hit)) = self.intersect(&ray, f64::INFINITY) else {
+                    continue;
+                };
+                let p = ray.at(hit.t);
+                if self.unbounded.contains(&prim) && (p - center).length() <= reach {
+                    b = if b.is_empty() {
+                        Bounds3::new(p, p)
+                    } else {
+                        b.union_point(p)
+                    };
+                }
+            }
+        }
+        if b.is_empty() {
+            return (center, radius);
+        }
+        let r = 0.5 * (b.max - b.min).length();
+        (
+            (b.min + b.max) * 0.5,
+            if r > 0.0 { r.max(radius) } else { radius },
+        )
+    }
+
     /// The radius of a sphere about everything bounded (1 for an empty scene).
     pub fn radius(&self) -> f64 {
         let b = self.bounds();
@@ -221,6 +264,13 @@ impl Geometry {
         }
     }
 }
+
+/// How far from the bounded objects' centre [`Geometry::entry_sphere`] takes in what the
+/// camera sees of unbounded primitives, in their radius plus the camera's distance: a floor
+/// toward the horizon is cut there, as photons spread over a wider disk thin out everywhere.
+pub const ENTRY_REACH: f64 = 2.0;
+/// Camera rays per side of the grid that finds what the camera sees of them.
+const ENTRY_GRID: u32 = 16;
 
 /// Puts the triangles of every mesh not already in a `kind` structure into one, each distinct
 /// mesh once, so instances stay shared.
@@ -236,5 +286,58 @@ fn rebuild_meshes(primitives: &mut [Primitive], kind: AccelKind) {
                 *m = new.clone();
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::camera::{Camera, CameraSettings};
+    use crate::geometry::{Plane, Shape, Sphere};
+    use crate::kit;
+    use crate::math::{Transform, Vec3};
+    use crate::scene::SceneBuilder;
+
+    /// A small sphere before an infinite wall: light from infinity must enter through a
+    /// sphere that holds the part of the wall the camera sees (each corner ray's hit), not
+    /// only the sphere about the ball; without unbounded primitives it is the ball's.
+    #[test]
+    fn light_from_infinity_enters_where_the_camera_sees_an_infinite_wall() {
+        let mut b = SceneBuilder::default();
+        b.camera = CameraSettings {
+            position: Vec3::new(0.0, 0.0, 8.0),
+            look_at: Vec3::ZERO,
+            fov_degrees: 50.0,
+            ..CameraSettings::default()
+        };
+        let m = b.add_material("grey", kit::diffuse(crate::Color::gray(0.5)));
+        let ball = Shape::Sphere(Sphere::new(Vec3::ZERO, 0.5));
+        b.add_object("ball", ball.clone(), Transform::IDENTITY, m);
+        let alone = {
+            let camera = b.camera.clone();
+            let mut b = SceneBuilder::default();
+            b.camera = camera;
+            let m = b.add_material("grey", kit::diffuse(crate::Color::gray(0.5)));
+            b.add_object("ball", ball, Transform::IDENTITY, m);
+            b.build()
+        };
+        let wall = Shape::Plane(Plane::new(Vec3::new(0.0, 0.0, -3.0), Vec3::Z));
+        b.add_object("wall", wall, Transform::IDENTITY, m);
+        let scene = b.build();
+        let camera = Camera::new(&scene.camera, 64, 48);
+        assert_eq!(
+            alone.geometry.entry_sphere(&camera),
+            alone.geometry.bounding_sphere()
+        );
+        let (center, radius) = scene.geometry.entry_sphere(&camera);
+        for (x, y) in [(0.0, 0.0), (64.0, 0.0), (0.0, 48.0), (64.0, 48.0)] {
+            let ray = camera.ray(x, y);
+            let t = (-3.0 - ray.origin.z) / ray.direction.z;
+            let corner = ray.at(t);
+            assert!(
+                (corner - center).length() <= radius * (1.0 + 1e-9),
+                "{corner:?} outside the sphere at {center:?} of radius {radius}"
+            );
+        }
+        assert!(radius < 10.0, "{radius}: no wider than it needs");
     }
 }
