@@ -215,9 +215,8 @@ impl Geometry {
     /// about everything bounded, widened, where the scene has unbounded primitives (an
     /// infinite floor or wall), to take in what `camera` sees of them within [`ENTRY_REACH`]
     /// times (their radius + the camera's distance) of the bounded objects' centre. Without
-    /// that, no light path or
-    /// photon from the sky reaches the part of a floor or wall the camera sees beyond the
-    /// bounded objects.
+    /// that, no light path or photon from the sky reaches the part of a floor or wall the
+    /// camera sees beyond the bounded objects.
     pub fn entry_sphere(&self, camera: &Camera) -> (Vec3, f64) {
         let (center, radius) = self.bounding_sphere();
         if self.unbounded.is_empty() {
