@@ -3,7 +3,7 @@
 
 use crate::camera::CameraSettings;
 use crate::color::Color;
-use crate::geometry::{Polygon, Shape, Sphere};
+use crate::geometry::{Plane, Polygon, Shape, Sphere};
 use crate::light::{Attenuation, Emitter, Light};
 use crate::material::{
     ConductorMaterial, ConductorSpec, DiffuseMaterial, FloatTexture, Material, MaterialId,
@@ -229,6 +229,66 @@ pub fn lamp_over_floor_image_mean(albedo: f64, point: bool, size: u32) -> f64 {
                 .intersect(&ray, f64::INFINITY)
                 .expect("the floor");
             sum += lamp_over_floor_radiance(albedo, point, ray.at(hit.t));
+        }
+    }
+    sum / (16 * size * size) as f64
+}
+
+/// Two infinite diffuse planes meeting at a right angle under a uniform sky of radiance 1:
+/// the floor y = 0 (reflectance `floor`) and the wall z = −3 (reflectance `wall`), seen
+/// from (0, 1.2, 7) with a 40° field, which meets nothing else. Light from infinity reaches
+/// each plane from half of the sky, the rest hidden by the other plane, and the planes light
+/// each other from far beyond what the camera sees: [`corner_under_sky_radiance`].
+pub fn corner_under_sky(floor: f64, wall: f64) -> Scene {
+    let mut b = SceneBuilder::default();
+    b.camera = CameraSettings {
+        position: Vec3::new(0.0, 1.2, 7.0),
+        look_at: Vec3::new(0.0, 0.5, 0.0),
+        fov_degrees: 40.0,
+        ..CameraSettings::default()
+    };
+    for (name, albedo, point, normal) in [
+        ("floor", floor, Vec3::ZERO, Vec3::Y),
+        ("wall", wall, Vec3::new(0.0, 0.0, -3.0), Vec3::Z),
+    ] {
+        let m = b.add_material(name, diffuse(Color::gray(albedo)));
+        let plane = Shape::Plane(Plane::new(point, normal));
+        b.add_object(name, plane, Transform::IDENTITY, m);
+    }
+    let radiance = Color::WHITE;
+    b.add_light("sky", Light::Infinite { radiance });
+    b.build()
+}
+
+/// The radiance of the floor and of the wall of [`corner_under_sky`], the same at every
+/// point and toward every direction, over paths of up to `max_depth` + 1 scattering
+/// vertices. Each plane sees the other over exactly half its hemisphere's projected solid
+/// angle wherever it is (the other is infinite), and the sky over the other half, so
+/// B_f = ρ_f (L + B_w)/2 and B_w = ρ_w (L + B_f)/2: each bounce one more term.
+pub fn corner_under_sky_radiance(floor: f64, wall: f64, max_depth: u32) -> (f64, f64) {
+    let (mut f, mut w) = (0.5 * floor, 0.5 * wall);
+    for _ in 0..max_depth {
+        (f, w) = (0.5 * floor * (1.0 + w), 0.5 * wall * (1.0 + f));
+    }
+    (f, w)
+}
+
+/// The mean over a `size`² image of [`corner_under_sky`] of its radiance
+/// ([`corner_under_sky_radiance`]), each pixel the mean of 4 × 4 points of it.
+pub fn corner_under_sky_image_mean(floor: f64, wall: f64, max_depth: u32, size: u32) -> f64 {
+    let scene = corner_under_sky(floor, wall);
+    let (f, w) = corner_under_sky_radiance(floor, wall, max_depth);
+    let camera = crate::camera::Camera::new(&scene.camera, size, size);
+    let mut sum = 0.0;
+    for (x, y) in (0..size * size).map(|i| (i % size, i / size)) {
+        for k in 0..16 {
+            let (dx, dy) = ((k % 4) as f64 / 4.0 + 0.125, (k / 4) as f64 / 4.0 + 0.125);
+            let ray = camera.sample_ray(x as f64 + dx, y as f64 + dy, [0.5; 2], 0.0);
+            let (_, hit) = scene
+                .geometry
+                .intersect(&ray, f64::INFINITY)
+                .expect("the floor or the wall");
+            sum += if ray.at(hit.t).y < 1e-9 { f } else { w };
         }
     }
     sum / (16 * size * size) as f64

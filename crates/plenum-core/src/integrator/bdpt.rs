@@ -781,14 +781,15 @@ impl<'a> BidirectionalPathTracer<'a> {
     /// The area density at `next` of light leaving the light vertex `v` toward it.
     fn pdf_light(&self, v: &Vertex, next: &Vertex) -> f64 {
         if v.infinite {
-            // Light from infinity enters through a disk of the bounded scene's radius: a
-            // point outside that beam (on an infinite plane, far out) no light path reaches.
-            // Its density is the least positive number, not 0, which the weights would read
-            // as a delta lobe's and remap to 1.
+            // Light from infinity enters through the entry disk (started beyond the
+            // unbounded primitives behind it, `Geometry::from_infinity`): a point outside
+            // that beam (on an infinite plane, far out) no light path reaches. Its density
+            // is the least positive number, not 0, which the weights would read as a delta
+            // lobe's and remap to 1.
             let w = v.toward_light;
             let q = next.p - self.center;
             let along = q.dot(w);
-            if along > self.radius || (q - w * along).length_squared() > self.radius * self.radius {
+            if (q - w * along).length_squared() > self.radius * self.radius {
                 return f64::MIN_POSITIVE;
             }
             let mut pdf = 1.0 / (PI * self.radius * self.radius);

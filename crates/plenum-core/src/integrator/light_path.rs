@@ -40,7 +40,11 @@ pub(super) fn start_light_path(
     let ul = stream.next_1d();
     let (u_pos, u_dir) = (stream.next_2d(), stream.next_2d());
     let (index, pmf) = scene.lights.sampler.sample(ul)?;
-    let es = scene.lights[index as usize].sample_le(u_pos, u_dir, center, radius)?;
+    let light = &scene.lights[index as usize];
+    let mut es = light.sample_le(u_pos, u_dir, center, radius)?;
+    if light.is_infinite() || light.is_delta_direction() {
+        es.ray = scene.geometry.from_infinity(es.ray);
+    }
     let le = emitted_spectrum(scene, index, &es, wl);
     if le.is_black() || es.pdf.pos == 0.0 || es.pdf.dir == 0.0 {
         return None;

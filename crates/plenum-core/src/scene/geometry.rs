@@ -252,6 +252,31 @@ impl Geometry {
         )
     }
 
+    /// The ray of light from infinity along `ray`'s direction through its origin, a point
+    /// of the entry disk: started instead beyond every unbounded primitive that the line
+    /// crosses behind that point. The disk lies outside everything bounded, not outside an
+    /// infinite plane; light started in front of a floor that it has crossed on its way from
+    /// infinity would reach, through the floor, what the floor shades (the light from below
+    /// the horizon on a wall above a floor).
+    pub fn from_infinity(&self, ray: Ray) -> Ray {
+        let mut origin = ray.origin;
+        // A plane is crossed once; a shape with several crossings takes several rounds.
+        for _ in 0..=4 * self.unbounded.len() {
+            let back = Ray::new(origin, -ray.direction);
+            let far = self
+                .unbounded
+                .iter()
+                .filter_map(|&i| self.primitives[i as usize].intersect(&back, f64::INFINITY))
+                .map(|hit| hit.t)
+                .fold(0.0, f64::max);
+            if far == 0.0 {
+                break;
+            }
+            origin = back.at(far + 1e-6 * (1.0 + far));
+        }
+        Ray { origin, ..ray }
+    }
+
     /// The radius of a sphere about everything bounded (1 for an empty scene).
     pub fn radius(&self) -> f64 {
         let b = self.bounds();
