@@ -17,7 +17,7 @@ use plenum_core::integrator::{ColorMode, IntegratorConfig, IntegratorKind, MAX_D
 use plenum_core::light_sampler::LightSamplerKind;
 use plenum_core::raw_film::RawFilm;
 use plenum_core::render::{
-    new_film, render_film, Adaptive, RenderControl, RenderSettings, MAX_SUBDIVISION,
+    new_film, render_film, Adaptive, Crop, RenderControl, RenderSettings, MAX_SUBDIVISION,
 };
 use plenum_core::sampling::{Filter, FilterKind, PixelSampler, SamplerKind, MAX_SPP};
 use plenum_scene::{builtin_scene_with, load_scene_with, LoadedScene};
@@ -210,6 +210,13 @@ struct RenderArgs {
     /// (-o NAME.plf) that `plenum merge` sums with the other ranges' into the image.
     #[arg(long)]
     samples: Option<SampleRange>,
+    /// Render only a part of the image, each pixel as the whole render makes it, into an
+    /// image of the part's size: columns X0 to X1 − 1 and rows Y0 to Y1 − 1 in pixels, or,
+    /// written with decimal points, fractions of the width and height as pbrt's
+    /// --cropwindow (0.25,0.75,0,0.5). Not for light tracing or BDPT, whose pixels take
+    /// light from every pixel's samples, nor adaptive sampling by variance.
+    #[arg(long, value_name = "X0,X1,Y0,Y1", allow_negative_numbers = true)]
+    crop: Option<CropArg>,
     #[command(flatten)]
     view: ViewArgs,
     /// Worker threads (default, or 0: all cores; at most 1024). The image does not depend
@@ -290,6 +297,57 @@ impl std::str::FromStr for SampleRange {
             return Err(bad());
         }
         Ok(SampleRange(a..b))
+    }
+}
+
+/// `--crop X0,X1,Y0,Y1`: pixels, or (with a decimal point) fractions of the image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum CropArg {
+    Pixels([u32; 4]),
+    Fractions([f64; 4]),
+}
+
+impl std::str::FromStr for CropArg {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || {
+            format!("expected X0,X1,Y0,Y1: four whole pixel coordinates (0,64,0,32) or four fractions of the image from 0 to 1 (0.25,0.75,0,0.5), not `{s}`")
+        };
+        let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+        if parts.len() != 4 {
+            return Err(bad());
+        }
+        if s.contains('.') {
+            let mut f = [0.0; 4];
+            for (v, p) in f.iter_mut().zip(&parts) {
+                *v = p.parse().map_err(|_| bad())?;
+                if !(0.0..=1.0).contains(v) {
+                    return Err(bad());
+                }
+            }
+            Ok(CropArg::Fractions(f))
+        } else {
+            let mut px = [0; 4];
+            for (v, p) in px.iter_mut().zip(&parts) {
+                *v = p.parse().map_err(|_| bad())?;
+            }
+            Ok(CropArg::Pixels(px))
+        }
+    }
+}
+
+impl CropArg {
+    /// The pixels of a `width` × `height` image it names; fractions as pbrt-v4 rounds them
+    /// (up, at both ends).
+    fn pixels(self, width: u32, height: u32) -> Crop {
+        let [x0, x1, y0, y1] = match self {
+            CropArg::Pixels(p) => p,
+            CropArg::Fractions([a, b, c, d]) => {
+                let at = |f: f64, n: u32| (f * n as f64).ceil() as u32;
+                [at(a, width), at(b, width), at(c, height), at(d, height)]
+            }
+        };
+        Crop { x0, x1, y0, y1 }
     }
 }
 
@@ -627,6 +685,7 @@ fn render_settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSe
         },
         seed: view.seed,
         corners: view.nff_corners,
+        crop: None,
     };
     if let Err(e) = settings.check() {
         return Err(e.to_string());
@@ -854,6 +913,12 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
         eprintln!("error: {e}");
         ExitCode::from(2)
     };
+    if let Some(crop) = args.crop {
+        settings.crop = Some(crop.pixels(settings.width, settings.height));
+        if let Err(e) = settings.check() {
+            return refuse(format!("--crop: {e}"));
+        }
+    }
     if let Some(dir) = &args.write_strategies {
         if settings.integrator.kind != IntegratorKind::Bdpt {
             return refuse("--write-strategies needs --integrator bdpt".to_string());
@@ -970,12 +1035,8 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
         settings.adaptive.is_some(),
         strategy_images,
     );
-    if let Err(e) = memory::check(
-        settings.width,
-        settings.height,
-        per_pixel,
-        memory::available(),
-    ) {
+    let (image_width, image_height) = settings.image_size();
+    if let Err(e) = memory::check(image_width, image_height, per_pixel, memory::available()) {
         return refuse(e);
     }
     let samples = args.samples.as_ref().map_or(0..spp, |r| r.0.clone());

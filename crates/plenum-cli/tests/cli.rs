@@ -1576,3 +1576,65 @@ fn the_variance_aov_is_written_beside_the_image() {
         assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
     }
 }
+
+/// `--crop` renders a part of the image: in pixels, or in fractions as pbrt's crop window,
+/// each pixel the whole render's (PFM, bit for bit); a crop outside the image, a malformed
+/// one and one under BDPT are refused, exit 2.
+#[test]
+fn a_crop_renders_part_of_the_image_as_the_whole_render_does() {
+    let tmp = temp_dir("crop");
+    let dir = tmp.path();
+    let args = cornell_args("16", "4");
+    let run = |extra: &[&str]| {
+        plenum()
+            .current_dir(dir)
+            .arg("render")
+            .args(&args)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = run(&["-o", "whole.pfm"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let whole = plenum_image::read_float_image(&dir.join("whole.pfm")).unwrap();
+    for (crop, (x0, y0, w, h)) in [
+        ("4,12,2,7", (4, 2, 8, 5)),
+        ("0.25,0.5,0.5,1.0", (4, 8, 4, 8)),
+    ] {
+        let o = run(&["--crop", crop, "-o", "part.pfm"]);
+        assert!(o.status.success(), "{crop}: {}", stderr(&o));
+        let part = plenum_image::read_float_image(&dir.join("part.pfm")).unwrap();
+        assert_eq!((part.width, part.height), (w, h), "{crop}");
+        for y in 0..h {
+            for x in 0..w {
+                assert_eq!(
+                    part.pixels[(y * w + x) as usize],
+                    whole.pixels[((y + y0) * 16 + x + x0) as usize],
+                    "{crop}: pixel ({}, {})",
+                    x + x0,
+                    y + y0
+                );
+            }
+        }
+    }
+    for (extra, says) in [
+        (
+            &["--crop", "0,17,0,4"][..],
+            "is not a part of the 16×16 image",
+        ),
+        (
+            &["--crop", "4,4,0,4"][..],
+            "is not a part of the 16×16 image",
+        ),
+        (&["--crop", "1,2,3"][..], "expected X0,X1,Y0,Y1"),
+        (&["--crop", "0.5,1.5,0,1"][..], "expected X0,X1,Y0,Y1"),
+        (
+            &["--crop", "0,8,0,8", "--integrator", "bdpt"][..],
+            "integrator `bdpt` cannot render a part of the image",
+        ),
+    ] {
+        let o = run(extra);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
+    }
+}

@@ -277,6 +277,18 @@ pub struct RenderSettings {
     /// The SPD test procedure (Haines 1987): one ray through every pixel corner, (W+1)×(H+1)
     /// rays in all, each pixel the average of its four corners. Replaces the sampler.
     pub corners: bool,
+    /// Render this part of the `width` × `height` image alone, each pixel as the whole
+    /// render makes it (pbrt's crop window); the image is the part's size.
+    pub crop: Option<Crop>,
+}
+
+/// A part of the image: the pixel columns `x0..x1` and rows `y0..y1`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Crop {
+    pub x0: u32,
+    pub x1: u32,
+    pub y0: u32,
+    pub y1: u32,
 }
 
 impl Default for RenderSettings {
@@ -290,14 +302,38 @@ impl Default for RenderSettings {
             integrator: IntegratorConfig::default(),
             seed: 0,
             corners: false,
+            crop: None,
         }
     }
 }
 
 impl RenderSettings {
+    /// The size of the image rendered: the crop's, or the whole.
+    pub fn image_size(&self) -> (u32, u32) {
+        self.crop
+            .map_or((self.width, self.height), |c| (c.x1 - c.x0, c.y1 - c.y0))
+    }
+
+    /// Where the rendered image's pixel (0, 0) lies in the whole image.
+    pub fn image_origin(&self) -> (u32, u32) {
+        self.crop.map_or((0, 0), |c| (c.x0, c.y0))
+    }
+
     /// Whether the integrator can work with these settings; the reason where it cannot.
     pub fn check(&self) -> Result<(), String> {
         let kind = self.integrator.kind;
+        if let Some(c) = self.crop {
+            let (w, h) = (self.width, self.height);
+            if !(c.x0 < c.x1 && c.x1 <= w && c.y0 < c.y1 && c.y1 <= h) {
+                return Err(format!("the crop {},{},{},{} is not a part of the {w}×{h} image: columns x0 < x1 ≤ {w}, rows y0 < y1 ≤ {h}", c.x0, c.x1, c.y0, c.y1));
+            }
+            if kind.splats() {
+                return Err(format!("integrator `{}` cannot render a part of the image: its pixels take light from the light paths of every pixel's samples", kind.name()));
+            }
+            if matches!(self.adaptive, Some(Adaptive::Variance { .. })) {
+                return Err("adaptive sampling by variance cannot render a part of the image: its second pass looks at each pixel's neighbours, some beyond the part".to_string());
+            }
+        }
         if matches!(kind, IntegratorKind::Photon | IntegratorKind::Sppm) {
             self.integrator.photon.check()?;
         }

@@ -127,9 +127,10 @@ pub struct Sppm;
 impl WholeImage for Sppm {
     /// An empty SPPM film for `settings`: its iterations are the sampler's samples per pixel.
     fn new_film(&self, settings: &RenderSettings) -> RawFilm {
+        let (w, h) = settings.image_size();
         RawFilm::progressive(
-            settings.width,
-            settings.height,
+            w,
+            h,
             settings.sampler.samples_per_pixel().max(1),
             photons_per_iteration(settings),
         )
@@ -145,8 +146,8 @@ impl WholeImage for Sppm {
         film: &mut RawFilm,
         control: RenderControl,
     ) -> RenderOutput {
-        let (w, h) = (settings.width, settings.height);
-        let camera = Camera::new(&scene.camera, w, h);
+        let camera = Camera::new(&scene.camera, settings.width, settings.height);
+        let (w, (ox, oy)) = (settings.image_size().0, settings.image_origin());
         let config = &settings.integrator;
         let iterations = film.samples.end;
         let state = film
@@ -183,7 +184,8 @@ impl WholeImage for Sppm {
                 .par_iter_mut()
                 .enumerate()
                 .fold(RayCounts::default, |mut c, (i, px)| {
-                    eye.camera_path(i as u32 % w, i as u32 / w, px, &mut c, None);
+                    let (x, y) = (i as u32 % w, i as u32 / w);
+                    eye.camera_path(x + ox, y + oy, px, &mut c, None);
                     c
                 })
                 .reduce(RayCounts::default, add_counts);
@@ -368,7 +370,8 @@ fn iteration_wavelengths(settings: &RenderSettings, iteration: u32) -> SampledWa
     }
 }
 
-/// Photon paths per iteration: the setting, or one per pixel.
+/// Photon paths per iteration: the setting, or one per pixel of the whole image (a crop's
+/// too, so that its pixels gather the whole render's photons).
 fn photons_per_iteration(settings: &RenderSettings) -> u64 {
     match settings.integrator.photon.sppm_photons {
         0 => settings.width as u64 * settings.height as u64,
