@@ -29,3 +29,6 @@ pub use sampled::{
 };
 pub use spectrum::Spectrum;
 pub use uplift::{RgbSigmoid, RgbToSpectrumTable};
+
+/// [`RgbToSpectrumTable::srgb`]'s table, which build.rs builds.
+static SRGB_TABLE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/srgb_table.bin"));

@@ -394,12 +394,41 @@ const TABLE_TOLERANCE: f64 = 1e-4;
 pub const SRGB_TABLE_RES: usize = 24;
 
 impl RgbToSpectrumTable {
-    /// The table for linear sRGB reflectances under D65, built on first use (0.2–0.3 s
-    /// of solves at [`SRGB_TABLE_RES`], measured on a loaded machine, on three threads)
-    /// and shared.
+    /// The table for linear sRGB reflectances under D65, at [`SRGB_TABLE_RES`]: built when
+    /// the crate is (its build script runs [`RgbToSpectrumTable::build`], 0.2–0.3 s of
+    /// solves that every spectral render paid at its start before), read on first use and
+    /// shared.
     pub fn srgb() -> &'static RgbToSpectrumTable {
         static TABLE: OnceLock<RgbToSpectrumTable> = OnceLock::new();
-        TABLE.get_or_init(|| RgbToSpectrumTable::build(SRGB_TABLE_RES))
+        TABLE.get_or_init(|| {
+            RgbToSpectrumTable::from_bytes(SRGB_TABLE_RES, crate::SRGB_TABLE)
+                .expect("the build script's table, of SRGB_TABLE_RES")
+        })
+    }
+
+    /// The table as bytes: its z nodes, then its coefficients, little-endian f64.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let values = self.z_nodes.iter().chain(self.coeffs.iter().flatten());
+        values.flat_map(|v| v.to_le_bytes()).collect()
+    }
+
+    /// The table of `res` nodes per axis that [`RgbToSpectrumTable::to_bytes`] wrote; `None`
+    /// where `bytes` is not one.
+    pub fn from_bytes(res: usize, bytes: &[u8]) -> Option<RgbToSpectrumTable> {
+        let count = res + 9 * res * res * res;
+        if res < 3 || bytes.len() != 8 * count {
+            return None;
+        }
+        let values: Vec<f64> = bytes
+            .chunks_exact(8)
+            .map(|b| f64::from_le_bytes(b.try_into().unwrap_or_default()))
+            .collect();
+        let (z_nodes, coeffs) = values.split_at(res);
+        Some(RgbToSpectrumTable {
+            res,
+            z_nodes: z_nodes.to_vec(),
+            coeffs: coeffs.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        })
     }
 
     /// Builds a table of `res` ≥ 3 nodes per axis (3·res³ solves). Each column of constant
@@ -573,5 +602,17 @@ mod tests {
             worst = worst.max(max_err(rgb, back));
         }
         assert!(worst < 0.01, "worst {worst}");
+    }
+
+    /// The table the build script made is the one this build of the code makes, value for
+    /// value; bytes of another size are refused.
+    #[test]
+    fn the_built_table_is_the_table_the_code_builds() {
+        let built = RgbToSpectrumTable::srgb();
+        let fresh = RgbToSpectrumTable::build(SRGB_TABLE_RES);
+        assert_eq!(built.z_nodes, fresh.z_nodes);
+        assert_eq!(built.coeffs, fresh.coeffs);
+        assert!(RgbToSpectrumTable::from_bytes(SRGB_TABLE_RES, &fresh.to_bytes()[8..]).is_none());
+        assert!(RgbToSpectrumTable::from_bytes(SRGB_TABLE_RES + 1, &fresh.to_bytes()).is_none());
     }
 }
