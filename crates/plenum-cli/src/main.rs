@@ -3,6 +3,7 @@
 //! Exit codes: 0 success; 1 an output file could not be written; 2 bad input (a scene error,
 //! a bad argument); 130 interrupted by Ctrl-C, after writing what was rendered.
 
+mod aov;
 mod bench;
 #[cfg(feature = "embree")]
 mod embree;
@@ -183,12 +184,16 @@ struct RenderArgs {
     /// raw film (for `plenum merge`).
     #[arg(short, long, default_value = "plenum.png")]
     output: PathBuf,
-    /// Also write, beside the output, `variance`: each pixel's variance of its value from its
-    /// own samples, to NAME.variance.EXT (what a z-test of one render against a reference
-    /// needs). Not for light tracing, BDPT or SPPM, whose pixels are not their own samples'
-    /// mean, nor for adaptive subdivision or the SPD corners.
-    #[arg(long, value_parser = ["variance"])]
-    aov: Option<String>,
+    /// Also write these views beside the output NAME.EXT, each to NAME.VIEW.EXT
+    /// (comma-separated): `rays` (rays traced per pixel, of every kind), `spp` (camera
+    /// rays per pixel: the samples adaptive sampling took), `depth` (the deepest bounce of
+    /// its camera paths), `normal`, `albedo` and `position` (what the pixel's camera rays
+    /// first meet, the mean over its samples), and `variance` (each pixel's variance of its value from its own samples, what a z-test
+    /// of one render against a reference needs; not for light tracing, BDPT or SPPM, whose
+    /// pixels are not their own samples' mean, nor for adaptive subdivision or the SPD
+    /// corners). A PNG shows a view scaled; EXR and PFM keep its values.
+    #[arg(long, value_name = "VIEWS")]
+    aov: Option<aov::AovList>,
     /// Save the render's state to this film file (.plf) every --checkpoint-every seconds
     /// and when it is stopped (Ctrl-C, --time-limit); `--resume FILE` continues it. Removed
     /// once the image is written.
@@ -686,6 +691,7 @@ fn render_settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSe
         seed: view.seed,
         corners: view.nff_corners,
         crop: None,
+        pixel_rays: false,
     };
     if let Err(e) = settings.check() {
         return Err(e.to_string());
@@ -980,19 +986,11 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
     if args.samples.is_some() && settings.integrator.kind == IntegratorKind::Sppm {
         return refuse("--samples cannot split integrator `sppm`: each iteration gathers within the radii the iterations before it left, so its iterations cannot be rendered apart (render it whole; --checkpoint keeps it safe)".to_string());
     }
-    let variance_output = args.aov.as_ref().map(|_| variance_path(&args.output));
-    if variance_output.is_some() {
-        let kind = settings.integrator.kind;
-        if kind.splats() || kind == IntegratorKind::Sppm {
-            return refuse(format!("--aov variance is not available with integrator `{}`: its pixels are not the mean of their own samples (light paths land anywhere; SPPM's iterations share their radii)", kind.name()));
-        }
-        if settings.corners || matches!(settings.adaptive, Some(Adaptive::Subdivide { .. })) {
-            return refuse("--aov variance needs pixels made of samples: adaptive subdivision and the SPD corners compute each pixel whole".to_string());
-        }
-        if film_output {
-            return refuse(format!("--aov variance writes an image: the raw film (.{FILM_EXTENSION}) already holds what it is made of"));
-        }
+    let views = args.aov.clone().unwrap_or_default();
+    if let Err(e) = views.check(&settings, keeps_film, film_output) {
+        return refuse(e);
     }
+    settings.pixel_rays = views.needs_pixel_rays();
     if keeps_film && settings.integrator.strategies {
         return refuse("--write-strategies cannot be combined with checkpoints, --time-limit, --samples or film output: the strategy images are not kept in the film".to_string());
     }
@@ -1152,13 +1150,17 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
         }
         return ExitCode::from(1);
     }
-    // Refused above wherever the film has no variance image; computed only when asked for.
-    if let Some(path) = &variance_output {
-        if let Some(v) = film.variance_image() {
-            if let Err(e) = plenum_image::write_image(path, v.width, v.height, v.pixels(), 0.0) {
-                eprintln!("error: {e}");
-                return ExitCode::from(1);
+    match views.write(&args.output, &film, &output, &loaded.scene, &settings) {
+        Ok(notes) => {
+            if !args.quiet {
+                for n in notes {
+                    eprintln!("{n}");
+                }
             }
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(1);
         }
     }
     if let Some(dir) = &args.write_strategies {
@@ -1250,15 +1252,6 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
         let _ = std::fs::remove_file(path);
     }
     ExitCode::SUCCESS
-}
-
-/// Where `--aov variance` writes: NAME.variance.EXT beside the output NAME.EXT.
-fn variance_path(output: &Path) -> PathBuf {
-    let stem = output.file_stem().unwrap_or_default().to_string_lossy();
-    let ext = output
-        .extension()
-        .map_or(String::new(), |e| format!(".{}", e.to_string_lossy()));
-    output.with_file_name(format!("{stem}.variance{ext}"))
 }
 
 /// `plenum merge`: the parts' films summed in the order of their sample ranges.

@@ -1638,3 +1638,95 @@ fn a_crop_renders_part_of_the_image_as_the_whole_render_does() {
         assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
     }
 }
+
+/// `--aov rays,spp,depth,normal,albedo,position` beside the image: the rays per pixel add
+/// up to the summary line's (camera, shadow, reflection, refraction), the camera rays per
+/// pixel are the samples, the deepest bounce within `max_depth`; the first-hit views are of the image's size, the normals unit length,
+/// the albedo within [0, 1]; a PNG's view says what its white stands for. An unknown view,
+/// and rays under SPPM, are refused, exit 2.
+#[test]
+fn the_views_of_where_the_work_goes_add_up_to_the_render() {
+    let tmp = temp_dir("views");
+    let dir = tmp.path();
+    let args: Vec<String> = cornell_args("12", "4")
+        .into_iter()
+        .filter(|a| a != "--quiet")
+        .collect();
+    let o = plenum()
+        .current_dir(dir)
+        .arg("render")
+        .args(&args)
+        .args(["--integrator", "path", "--max-depth", "5"])
+        .args(["--aov", "rays,spp,depth,normal,albedo,position"])
+        .args(["-o", "out.pfm"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let rays_line = err
+        .split("rays: ")
+        .nth(1)
+        .and_then(|s| s.split(';').next())
+        .unwrap_or_else(|| panic!("no summary: {err}"));
+    let summary: f64 = rays_line
+        .split(", ")
+        .map(|part| part.split(' ').next().unwrap().parse::<f64>().unwrap())
+        .sum();
+    let read =
+        |view: &str| plenum_image::read_float_image(&dir.join(format!("out.{view}.pfm"))).unwrap();
+    let rays = read("rays");
+    assert_eq!((rays.width, rays.height), (12, 12));
+    let per_pixel: f64 = rays.pixels.iter().map(|p| p[0] as f64).sum();
+    assert_eq!(per_pixel, summary, "{err}");
+    assert!(read("spp").pixels.iter().all(|p| p[0] == 4.0));
+    let depth = read("depth");
+    assert!(depth
+        .pixels
+        .iter()
+        .all(|p| p[0] <= 5.0 && p[0].fract() == 0.0));
+    assert!(
+        depth.pixels.iter().any(|p| p[0] >= 2.0),
+        "paths bounce in the box"
+    );
+    for n in read("normal").pixels {
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        assert!(len < 1.0001, "{n:?}");
+    }
+    assert!(read("albedo")
+        .pixels
+        .iter()
+        .flatten()
+        .all(|c| (0.0..=1.0001).contains(c)));
+    assert_eq!(read("position").pixels.len(), 144);
+    let o = plenum()
+        .current_dir(dir)
+        .arg("render")
+        .args(&args)
+        .args(["--aov", "rays,normal", "-o", "out.png"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("out.rays.png: black 0, white"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(image_size(&dir.join("out.normal.png")), (12, 12));
+    for (extra, says) in [
+        (&["--aov", "rays,depht"][..], "unknown view `depht`"),
+        (
+            &["--aov", "rays", "--integrator", "sppm"][..],
+            "not available with integrator `sppm`",
+        ),
+    ] {
+        let o = plenum()
+            .current_dir(dir)
+            .arg("render")
+            .args(&args)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
+    }
+}

@@ -218,6 +218,12 @@ pub fn lamp_over_floor_radiance(albedo: f64, point: bool, p: Vec3) -> f64 {
 /// each pixel the mean of 4 × 4 points of it.
 pub fn lamp_over_floor_image_mean(albedo: f64, point: bool, size: u32) -> f64 {
     let scene = lamp_over_floor(albedo, point);
+    image_mean(&scene, size, |p| lamp_over_floor_radiance(albedo, point, p))
+}
+
+/// The mean over a `size`² image of `scene` of `radiance` at the point each camera ray
+/// first meets (which every ray must), each pixel the mean of 4 × 4 points of it.
+fn image_mean(scene: &Scene, size: u32, radiance: impl Fn(Vec3) -> f64) -> f64 {
     let camera = crate::camera::Camera::new(&scene.camera, size, size);
     let mut sum = 0.0;
     for (x, y) in (0..size * size).map(|i| (i % size, i / size)) {
@@ -227,8 +233,8 @@ pub fn lamp_over_floor_image_mean(albedo: f64, point: bool, size: u32) -> f64 {
             let (_, hit) = scene
                 .geometry
                 .intersect(&ray, f64::INFINITY)
-                .expect("the floor");
-            sum += lamp_over_floor_radiance(albedo, point, ray.at(hit.t));
+                .expect("every camera ray meets the scene");
+            sum += radiance(ray.at(hit.t));
         }
     }
     sum / (16 * size * size) as f64
@@ -276,20 +282,12 @@ pub fn corner_under_sky_radiance(floor: f64, wall: f64, max_depth: u32) -> (f64,
 /// The mean over a `size`² image of [`corner_under_sky`] of its radiance
 /// ([`corner_under_sky_radiance`]), each pixel the mean of 4 × 4 points of it.
 pub fn corner_under_sky_image_mean(floor: f64, wall: f64, max_depth: u32, size: u32) -> f64 {
-    let scene = corner_under_sky(floor, wall);
     let (f, w) = corner_under_sky_radiance(floor, wall, max_depth);
-    let camera = crate::camera::Camera::new(&scene.camera, size, size);
-    let mut sum = 0.0;
-    for (x, y) in (0..size * size).map(|i| (i % size, i / size)) {
-        for k in 0..16 {
-            let (dx, dy) = ((k % 4) as f64 / 4.0 + 0.125, (k / 4) as f64 / 4.0 + 0.125);
-            let ray = camera.sample_ray(x as f64 + dx, y as f64 + dy, [0.5; 2], 0.0);
-            let (_, hit) = scene
-                .geometry
-                .intersect(&ray, f64::INFINITY)
-                .expect("the floor or the wall");
-            sum += if ray.at(hit.t).y < 1e-9 { f } else { w };
+    image_mean(&corner_under_sky(floor, wall), size, |p| {
+        if p.y < 1e-9 {
+            f
+        } else {
+            w
         }
-    }
-    sum / (16 * size * size) as f64
+    })
 }

@@ -4,6 +4,7 @@
 //! arrive already built (see `plenum-scene`); images leave as a [`film::Film`] of linear RGB.
 
 pub mod accel;
+pub mod aov;
 pub mod bxdf;
 pub mod camera;
 pub mod color;

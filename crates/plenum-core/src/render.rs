@@ -16,11 +16,12 @@ use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::{Film, SplatBuffer};
 use crate::integrator::{whole_image, Integrator, RayCounts, RayTree, StrategyImages};
+use crate::math::Ray;
 use crate::raw_film::{PixelSums, RawFilm};
 use crate::sampling::{PixelSampler, Rng, SampleStream};
 use crate::scene::Scene;
 pub use crate::settings::{
-    Adaptive, Crop, RenderControl, RenderOutput, RenderSettings, MAX_SUBDIVISION,
+    Adaptive, Crop, PixelRays, RenderControl, RenderOutput, RenderSettings, MAX_SUBDIVISION,
 };
 use rayon::prelude::*;
 use std::ops::Range;
@@ -114,6 +115,8 @@ pub fn render_film(
         width: w,
         height: h,
         origin: settings.image_origin(),
+        pixel_rays: (settings.pixel_rays && !settings.corners)
+            .then(|| vec![PixelRays::default(); (w * h) as usize]),
         cancel: control.cancel,
         progress: control.progress,
         passes,
@@ -222,6 +225,7 @@ pub fn render_film(
         film: film.image(),
         counts,
         complete,
+        pixel_rays: tiles.pixel_rays.unwrap_or_default(),
     }
 }
 
@@ -231,6 +235,8 @@ struct Tiles<'a> {
     height: u32,
     /// Where the film's pixel (0, 0) lies in the whole image (a crop's corner).
     origin: (u32, u32),
+    /// Each film pixel's rays, where they are kept, summed over the passes.
+    pixel_rays: Option<Vec<PixelRays>>,
     cancel: &'a AtomicBool,
     progress: &'a (dyn Fn(usize, usize) + Sync),
     passes: usize,
@@ -282,8 +288,9 @@ impl Tiles<'_> {
                 tiles.len() * pass + tiles.len() - pending.len(),
             );
             let all_counts = Mutex::new(RayCounts::default());
+            let keep_rays = self.pixel_rays.is_some();
             {
-                let shared = Mutex::new(&mut *film);
+                let shared = Mutex::new((&mut *film, self.pixel_rays.as_mut()));
                 pending.par_iter().for_each(|&tile| {
                     if self.cancel.load(Ordering::Relaxed) {
                         return;
@@ -296,23 +303,40 @@ impl Tiles<'_> {
                         paused.store(true, Ordering::Relaxed);
                         return;
                     }
-                    let mut sums: Vec<(u32, u32, PixelSums)> = {
-                        let f = shared.lock().unwrap_or_else(|e| e.into_inner());
+                    let mut sums: Vec<(u32, u32, PixelSums, PixelRays)> = {
+                        let (f, _) = &*shared.lock().unwrap_or_else(|e| e.into_inner());
                         bounds(tile)
-                            .map(|(x, y)| (x, y, f.pixels[(y * w + x) as usize]))
+                            .map(|(x, y)| {
+                                let i = (y * w + x) as usize;
+                                (x, y, f.pixels[i], PixelRays::default())
+                            })
                             .collect()
                     };
                     let mut tile_counts = RayCounts::default();
                     let (ox, oy) = self.origin;
-                    for (x, y, s) in &mut sums {
+                    for (x, y, s, rays) in &mut sums {
+                        let before = tile_counts;
+                        // The deepest ray is the most, not a sum: the pixel's own, kept apart.
+                        tile_counts.deepest = 0;
                         pixel(*x + ox, *y + oy, s, &mut tile_counts);
+                        if keep_rays {
+                            rays.camera = tile_counts.camera - before.camera;
+                            rays.total = tile_counts.total() - before.total();
+                            rays.deepest = tile_counts.deepest;
+                        }
+                        tile_counts.deepest = tile_counts.deepest.max(before.deepest);
                     }
                     {
-                        let mut f = shared.lock().unwrap_or_else(|e| e.into_inner());
-                        for (x, y, s) in sums {
+                        let (f, kept) = &mut *shared.lock().unwrap_or_else(|e| e.into_inner());
+                        for (x, y, s, rays) in sums {
                             let i = (y * w + x) as usize;
                             f.pixels[i] = s;
                             f.stages[i] = stage;
+                            if let Some(kept) = kept.as_deref_mut() {
+                                kept[i].camera += rays.camera;
+                                kept[i].total += rays.total;
+                                kept[i].deepest = kept[i].deepest.max(rays.deepest);
+                            }
                         }
                     }
                     all_counts
@@ -416,20 +440,32 @@ fn sample_pixel(
     counts: &mut RayCounts,
     mut tree: Option<&mut RayTree>,
 ) {
+    for index in indices {
+        let (ray, weight, mut stream) = camera_sample(camera, settings, (x, y), index);
+        let c = integrator.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut());
+        estimate.add(c, weight);
+    }
+}
+
+/// Sample `index` of pixel (x, y) of the whole image: its camera ray, its filter weight,
+/// and its stream, where the integrator goes on drawing. In adaptive variance mode from
+/// the Sobol sequence, otherwise from the settings' sampler.
+pub fn camera_sample(
+    camera: &Camera,
+    settings: &RenderSettings,
+    (x, y): (u32, u32),
+    index: u32,
+) -> (Ray, f64, SampleStream) {
     let sampler = match settings.adaptive {
         Some(Adaptive::Variance { max_spp, .. }) => PixelSampler::Sobol { spp: max_spp },
         _ => settings.sampler,
     };
-    for index in indices {
-        let mut stream = sampler.stream(settings.seed, x, y, index);
-        let f = settings.filter.sample(stream.pixel());
-        let lens = stream.next_2d();
-        let shutter = stream.next_1d();
-        let (px, py) = (x as f64 + 0.5 + f.dx, y as f64 + 0.5 + f.dy);
-        let ray = camera.sample_ray(px, py, lens, shutter);
-        let c = integrator.camera_ray(&ray, &mut stream, counts, tree.as_deref_mut());
-        estimate.add(c, f.weight);
-    }
+    let mut stream = sampler.stream(settings.seed, x, y, index);
+    let f = settings.filter.sample(stream.pixel());
+    let lens = stream.next_2d();
+    let shutter = stream.next_1d();
+    let (px, py) = (x as f64 + 0.5 + f.dx, y as f64 + 0.5 + f.dy);
+    (camera.sample_ray(px, py, lens, shutter), f.weight, stream)
 }
 
 /// Adaptive variance mode: at least one more batch of samples, then more batches until the
@@ -782,5 +818,106 @@ mod tests {
             ..base(IntegratorKind::Path)
         };
         assert!(outside.check().is_err());
+    }
+
+    /// Each pixel's rays, kept when asked: they add up to the render's counts less the
+    /// photon pass (photon mapping), the camera rays to the samples taken, the deepest
+    /// bounce to the render's (its `max_depth` in a closed box, under path tracing and
+    /// BDPT), for a fixed sampler, adaptive sampling by variance and adaptive subdivision,
+    /// and a crop keeps the whole render's there (the kit's Cornell box, 10 × 8, seed 4).
+    #[test]
+    fn each_pixels_rays_add_up_to_the_renders() {
+        let scene = kit::cornell_box(true);
+        let base = RenderSettings {
+            width: 10,
+            height: 8,
+            sampler: PixelSampler::new(SamplerKind::Random, 4),
+            seed: 4,
+            pixel_rays: true,
+            ..RenderSettings::default()
+        };
+        let cancel = AtomicBool::new(false);
+        let variance = Adaptive::Variance {
+            threshold: 0.02,
+            min_spp: 4,
+            max_spp: 32,
+        };
+        let subdivide = Adaptive::Subdivide {
+            contrast: 0.05,
+            depth: 2,
+        };
+        let mut cases = Vec::new();
+        for kind in [
+            IntegratorKind::Whitted,
+            IntegratorKind::Path,
+            IntegratorKind::Bdpt,
+            IntegratorKind::Photon,
+        ] {
+            let mut settings = base.clone();
+            settings.integrator.kind = kind;
+            settings.integrator.photon.photons = 3000;
+            settings.integrator.photon.caustic_photons = 3000;
+            cases.push(settings);
+        }
+        for adaptive in [variance, subdivide] {
+            let mut settings = base.clone();
+            settings.integrator.kind = IntegratorKind::Path;
+            settings.adaptive = Some(adaptive);
+            cases.push(settings);
+        }
+        for settings in cases {
+            let out = render(&scene, &settings, &cancel, &|_, _| {});
+            let what = format!(
+                "{} {:?}",
+                settings.integrator.kind.name(),
+                settings.adaptive
+            );
+            assert_eq!(out.pixel_rays.len(), 80, "{what}");
+            let total: u64 = out.pixel_rays.iter().map(|r| r.total).sum();
+            let camera: u64 = out.pixel_rays.iter().map(|r| r.camera).sum();
+            let pass = match settings.integrator.kind {
+                IntegratorKind::Photon => out.counts.photon,
+                _ => 0,
+            };
+            assert_eq!(total, out.counts.total() - pass, "{what}");
+            assert_eq!(camera, out.counts.camera, "{what}");
+            let deepest = out.pixel_rays.iter().map(|r| r.deepest).max();
+            assert_eq!(deepest, Some(out.counts.deepest), "{what}");
+            let max_depth = settings.integrator.max_depth as u64;
+            match settings.integrator.kind {
+                IntegratorKind::Path | IntegratorKind::Bdpt => {
+                    assert_eq!(deepest, Some(max_depth), "{what}")
+                }
+                _ => assert!(deepest <= Some(max_depth), "{what}"),
+            }
+            if settings.adaptive.is_none() {
+                assert!(out.pixel_rays.iter().all(|r| r.camera == 4), "{what}");
+            } else {
+                let (least, most) = out.pixel_rays.iter().fold((u64::MAX, 0), |(a, b), r| {
+                    (a.min(r.camera), b.max(r.camera))
+                });
+                assert!(least < most, "{what}: every pixel took {least} camera rays");
+            }
+            // (A crop is refused to both: their pixels are not rendered alone.)
+            if settings.adaptive == Some(variance)
+                || settings.integrator.kind == IntegratorKind::Bdpt
+            {
+                continue;
+            }
+            let part = RenderSettings {
+                crop: Some(Crop {
+                    x0: 2,
+                    x1: 7,
+                    y0: 3,
+                    y1: 8,
+                }),
+                ..settings.clone()
+            };
+            let cropped = render(&scene, &part, &cancel, &|_, _| {}).pixel_rays;
+            for (i, r) in cropped.iter().enumerate() {
+                let (x, y) = (i % 5 + 2, i / 5 + 3);
+                assert_eq!(*r, out.pixel_rays[y * 10 + x], "{what}: pixel ({x}, {y})");
+            }
+        }
     }
 }

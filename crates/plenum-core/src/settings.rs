@@ -237,6 +237,10 @@ pub struct RayCounts {
     pub photon: u64,
     /// Samples that came out NaN or infinite and were left out of the film.
     pub invalid: u64,
+    /// The depth of the deepest reflected or refracted ray of the camera's paths (the
+    /// camera ray's is 0; the BSDF ray of a path's last vertex, which ends it, does not
+    /// count): the most, not a sum, which [`RayCounts::add`] keeps.
+    pub deepest: u64,
 }
 
 impl RayCounts {
@@ -259,6 +263,12 @@ impl RayCounts {
         self.connection += o.connection;
         self.photon += o.photon;
         self.invalid += o.invalid;
+        self.deepest = self.deepest.max(o.deepest);
+    }
+
+    /// Notes a reflected or refracted ray of depth `depth` on a camera path.
+    pub fn bounce(&mut self, depth: u32) {
+        self.deepest = self.deepest.max(depth as u64);
     }
 }
 
@@ -280,6 +290,22 @@ pub struct RenderSettings {
     /// Render this part of the `width` × `height` image alone, each pixel as the whole
     /// render makes it (pbrt's crop window); the image is the part's size.
     pub crop: Option<Crop>,
+    /// Keep each pixel's rays ([`RenderOutput::pixel_rays`]): what the `rays` and `spp`
+    /// views show.
+    pub pixel_rays: bool,
+}
+
+/// The rays traced for one pixel's samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PixelRays {
+    /// Camera rays: the samples taken (adaptive sampling's count, or the corner rays of
+    /// adaptive subdivision).
+    pub camera: u64,
+    /// Every ray, of every kind ([`RayCounts::total`]).
+    pub total: u64,
+    /// The depth of the deepest reflected or refracted ray of its camera paths
+    /// ([`RayCounts::deepest`]).
+    pub deepest: u64,
 }
 
 /// A part of the image: the pixel columns `x0..x1` and rows `y0..y1`.
@@ -303,6 +329,7 @@ impl Default for RenderSettings {
             seed: 0,
             corners: false,
             crop: None,
+            pixel_rays: false,
         }
     }
 }
@@ -395,6 +422,11 @@ pub struct RenderOutput {
     /// Bidirectional path tracing with `strategies` set: for each strategy (s, t), its
     /// image weighted by MIS and unweighted.
     pub strategies: Vec<(usize, usize, Film, Film)>,
+    /// With [`RenderSettings::pixel_rays`], each pixel's rays of this render, row by row
+    /// (of the film: the crop's pixels; empty for methods with a loop of their own, the
+    /// SPD corners, and otherwise). They add up to `counts`, less the rays of passes that
+    /// belong to no pixel (photon mapping's photons).
+    pub pixel_rays: Vec<PixelRays>,
 }
 
 /// What the caller of [`render_film`] may do while it runs.

@@ -20,7 +20,9 @@
 //! background, a Phong material's k_e) is found by s = 0 alone and so takes weight 1.
 
 use super::light_path::{adjoint_cosine_of, leave_light, start_light_path, LightStart};
-use super::{rgb, IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Stop, Strategy};
+use super::{
+    rgb, weight_rgb, IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Stop, Strategy,
+};
 use crate::accel::Coherence;
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
@@ -545,9 +547,15 @@ impl<'a> BidirectionalPathTracer<'a> {
                 (TransportMode::Importance, _) => counts.light += 1,
                 (_, true) => {
                     eta_scale *= bs.eta * bs.eta;
-                    counts.refraction += 1
+                    counts.refraction += 1;
                 }
                 (_, false) => counts.reflection += 1,
+            }
+            // The ray past `max_depth` only looks for an emitter to end the path on, as the
+            // path tracer's last BSDF sample does: not a bounce.
+            let depth = n as u32 - 1;
+            if mode == TransportMode::Radiance && depth <= self.max_depth {
+                counts.bounce(depth);
             }
             if beta.is_black() {
                 return;
@@ -936,7 +944,7 @@ fn record_subpath(
             RayKind::Camera if i > 0 => RayKind::Reflected,
             _ => kind,
         };
-        let mut node = RayNode::new(parent, k, i as u32, a.p, d, rgb(b.beta, wl));
+        let mut node = RayNode::new(parent, k, i as u32, a.p, d, weight_rgb(b.beta, wl));
         node.distance = (!b.infinite).then(|| (b.p - a.p).length());
         if let Some(prim) = b.primitive {
             node.object = Some(scene.geometry.names[prim as usize].clone());

@@ -5,7 +5,9 @@
 //! a BSDF sample. What a method does at a vertex (light sampling, a final gather, a visible
 //! point, Russian roulette) stays the method's own.
 
-use super::{direct, record, record_hit, rgb, RayCounts, RayKind, RayNode, RayTree, Stop};
+use super::{
+    direct, record, record_hit, rgb, weight_rgb, RayCounts, RayKind, RayNode, RayTree, Stop,
+};
 use crate::bxdf::{Bsdf, BsdfSample, TransportMode};
 use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::scene::{Interaction, Scene};
@@ -72,7 +74,7 @@ impl EyePath {
                 self.depth,
                 ray.origin,
                 ray.direction,
-                rgb(self.beta, wl),
+                weight_rgb(self.beta, wl),
             ))
         });
         let Some((prim, hit)) = scene.geometry.intersect(ray, f64::INFINITY) else {
@@ -129,6 +131,7 @@ impl EyePath {
             counts.reflection += 1;
             self.kind = RayKind::Reflected;
         }
+        counts.bounce(self.depth + 1);
         if self.beta.is_black() {
             return None;
         }

@@ -179,7 +179,7 @@ impl<'a> LightPaths<'a> {
                 _ => counts.light += 1,
             }
             if let Some(t) = tree.as_deref_mut() {
-                let c = super::rgb(beta, wl);
+                let c = super::weight_rgb(beta, wl);
                 parent = Some(t.push(RayNode::new(
                     parent,
                     kind,

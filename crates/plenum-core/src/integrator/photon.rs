@@ -42,8 +42,8 @@ use super::eye_path::EyePath;
 use super::photon_map::{Nearest, Photon, PhotonMap, Query};
 use super::photons::{emitted, escaped, shading_correction, PhotonTracer};
 use super::{
-    record, record_hit, rgb, FoundPhoton, IntegratorConfig, PhotonConfig, PhotonGather, RayCounts,
-    RayKind, RayNode, RayTree,
+    record, record_hit, rgb, weight_rgb, FoundPhoton, IntegratorConfig, PhotonConfig, PhotonGather,
+    RayCounts, RayKind, RayNode, RayTree,
 };
 use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
@@ -230,13 +230,14 @@ impl<'a> PhotonMapper<'a> {
                     e,
                     x.p,
                     bs.wi,
-                    rgb(w, wl),
+                    weight_rgb(w, wl),
                 ))
             });
             let before = sum;
             let pdf_bsdf = direct::bsdf_pdf(bsdf, wo, &bs);
             let first = e + 1;
             counts.reflection += 1;
+            counts.bounce(e);
             let mut ray =
                 Ray::new(offset_ray_origin(x.p, x.p_error, x.n, bs.wi), bs.wi).at_time(time);
             for ez in e + 1..=self.max_depth + 1 {
@@ -307,6 +308,7 @@ impl<'a> PhotonMapper<'a> {
                 w *= bs.f * (bs.wi.dot(it.shading_n).abs() / bs.pdf);
                 delta &= bs.is_specular();
                 counts.reflection += 1;
+                counts.bounce(ez);
                 ray =
                     Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(time);
             }

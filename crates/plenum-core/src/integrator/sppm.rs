@@ -268,6 +268,7 @@ impl WholeImage for Sppm {
             counts,
             complete: film.is_complete(1),
             strategies: Vec::new(),
+            pixel_rays: Vec::new(),
         }
     }
 

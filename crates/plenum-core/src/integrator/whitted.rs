@@ -330,6 +330,7 @@ impl<'a> Whitted<'a> {
                 RayKind::Reflected => counts.reflection += 1,
                 _ => counts.refraction += 1,
             }
+            counts.bounce(b.depth + 1);
             let origin = offset_ray_origin(it.p, it.p_error, n, direction);
             let child = Branch {
                 kind,

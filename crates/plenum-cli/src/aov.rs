@@ -1,0 +1,237 @@
+//! `--aov`: images beside the render, each to NAME.VIEW.EXT beside NAME.EXT. Where the
+//! work goes (`rays`, `spp`, `depth`), what the camera's rays first meet (`normal`, `albedo`,
+//! `position`), and how noisy each pixel is (`variance`). Float formats keep the values;
+//! a PNG shows them (counts scaled so that the largest is white, normals as (n + 1)/2,
+//! positions across their bounding box).
+
+use crate::FILM_EXTENSION;
+use plenum_core::aov::first_hits;
+use plenum_core::integrator::IntegratorKind;
+use plenum_core::raw_film::RawFilm;
+use plenum_core::render::{Adaptive, RenderOutput, RenderSettings};
+use plenum_core::scene::Scene;
+use std::path::{Path, PathBuf};
+
+/// One view.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Aov {
+    Variance,
+    Rays,
+    Spp,
+    Depth,
+    Normal,
+    Albedo,
+    Position,
+}
+
+impl Aov {
+    const ALL: [Aov; 7] = [
+        Aov::Variance,
+        Aov::Rays,
+        Aov::Spp,
+        Aov::Depth,
+        Aov::Normal,
+        Aov::Albedo,
+        Aov::Position,
+    ];
+
+    fn name(self) -> &'static str {
+        match self {
+            Aov::Variance => "variance",
+            Aov::Rays => "rays",
+            Aov::Spp => "spp",
+            Aov::Depth => "depth",
+            Aov::Normal => "normal",
+            Aov::Albedo => "albedo",
+            Aov::Position => "position",
+        }
+    }
+}
+
+/// `--aov a,b,…`: the views asked for, each once, in the order of [`Aov::ALL`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AovList(Vec<Aov>);
+
+impl std::str::FromStr for AovList {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let mut asked = Vec::new();
+        for name in s.split(',').map(str::trim) {
+            let Some(aov) = Aov::ALL.into_iter().find(|a| a.name() == name) else {
+                let names: Vec<&str> = Aov::ALL.iter().map(|a| a.name()).collect();
+                return Err(format!(
+                    "unknown view `{name}`: expected a comma-separated list of {}",
+                    names.join(", ")
+                ));
+            };
+            asked.push(aov);
+        }
+        Ok(AovList(
+            Aov::ALL.into_iter().filter(|a| asked.contains(a)).collect(),
+        ))
+    }
+}
+
+impl AovList {
+    fn has(&self, aov: Aov) -> bool {
+        self.0.contains(&aov)
+    }
+
+    /// Whether the render must keep each pixel's rays.
+    pub fn needs_pixel_rays(&self) -> bool {
+        self.has(Aov::Rays) || self.has(Aov::Spp) || self.has(Aov::Depth)
+    }
+
+    /// Why these views cannot go with `settings`, if they cannot: `keeps_film` (checkpoints,
+    /// a time limit, sample ranges) and `film_output` as the render is asked.
+    pub fn check(
+        &self,
+        settings: &RenderSettings,
+        keeps_film: bool,
+        film_output: bool,
+    ) -> Result<(), String> {
+        if self.0.is_empty() {
+            return Ok(());
+        }
+        let kind = settings.integrator.kind;
+        if film_output {
+            return Err(format!("--aov writes an image beside the output: the raw film (.{FILM_EXTENSION}) holds no views (render the image itself, or `plenum merge` the parts into one)"));
+        }
+        if self.has(Aov::Variance) {
+            if kind.splats() || kind == IntegratorKind::Sppm {
+                return Err(format!("--aov variance is not available with integrator `{}`: its pixels are not the mean of their own samples (light paths land anywhere; SPPM's iterations share their radii)", kind.name()));
+            }
+            if settings.corners || matches!(settings.adaptive, Some(Adaptive::Subdivide { .. })) {
+                return Err("--aov variance needs pixels made of samples: adaptive subdivision and the SPD corners compute each pixel whole".to_string());
+            }
+        }
+        if self.needs_pixel_rays() {
+            if kind == IntegratorKind::Sppm {
+                return Err("--aov rays, spp and depth are not available with integrator `sppm`: its photon passes belong to no pixel".to_string());
+            }
+            if settings.corners {
+                return Err("--aov rays, spp and depth are not available with the SPD corners: each corner ray belongs to four pixels".to_string());
+            }
+            if keeps_film {
+                return Err("--aov rays, spp and depth cannot be combined with checkpoints, --time-limit or --samples: the rays of each pixel are not kept in the film".to_string());
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes each view beside `output`; the lines that say what a PNG's white stands for.
+    pub fn write(
+        &self,
+        output: &Path,
+        film: &RawFilm,
+        rendered: &RenderOutput,
+        scene: &Scene,
+        settings: &RenderSettings,
+    ) -> Result<Vec<String>, String> {
+        let png = output
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        let hits = [Aov::Normal, Aov::Albedo, Aov::Position]
+            .iter()
+            .any(|&a| self.has(a))
+            .then(|| first_hits(scene, settings));
+        let (w, h) = settings.image_size();
+        let mut notes = Vec::new();
+        for &aov in &self.0 {
+            let path = aov_path(output, aov.name());
+            let counts = |f: fn(&plenum_core::render::PixelRays) -> u64| -> Vec<[f32; 3]> {
+                rendered
+                    .pixel_rays
+                    .iter()
+                    .map(|r| [f(r) as f32; 3])
+                    .collect()
+            };
+            let pixels: Vec<[f32; 3]> = match aov {
+                Aov::Variance => match film.variance_image() {
+                    Some(v) => v.pixels().to_vec(),
+                    None => continue,
+                },
+                Aov::Rays => counts(|r| r.total),
+                Aov::Spp => counts(|r| r.camera),
+                Aov::Depth => counts(|r| r.deepest),
+                Aov::Normal => hits.as_ref().map_or(Vec::new(), |h| h.normal.clone()),
+                Aov::Albedo => hits.as_ref().map_or(Vec::new(), |h| h.albedo.clone()),
+                Aov::Position => hits.as_ref().map_or(Vec::new(), |h| h.position.clone()),
+            };
+            let pixels = if png {
+                let (shown, note) = for_png(aov, pixels);
+                if let Some(n) = note {
+                    notes.push(format!("{}: {n}", path.display()));
+                }
+                shown
+            } else {
+                pixels
+            };
+            plenum_image::write_image(&path, w, h, &pixels, 0.0).map_err(|e| e.to_string())?;
+        }
+        Ok(notes)
+    }
+}
+
+/// NAME.VIEW.EXT beside the output NAME.EXT.
+pub fn aov_path(output: &Path, view: &str) -> PathBuf {
+    let stem = output.file_stem().unwrap_or_default().to_string_lossy();
+    let ext = output
+        .extension()
+        .map_or(String::new(), |e| format!(".{}", e.to_string_lossy()));
+    output.with_file_name(format!("{stem}.{view}{ext}"))
+}
+
+/// A view as a PNG shows it (linear values, which the PNG encodes as sRGB), and what its
+/// white stands for where that is not 1.
+fn for_png(aov: Aov, mut pixels: Vec<[f32; 3]>) -> (Vec<[f32; 3]>, Option<String>) {
+    match aov {
+        Aov::Rays | Aov::Spp | Aov::Depth => {
+            let most = pixels.iter().map(|p| p[0]).fold(0.0f32, f32::max);
+            if most > 0.0 {
+                for p in &mut pixels {
+                    *p = p.map(|c| c / most);
+                }
+            }
+            let what = match aov {
+                Aov::Rays => "rays",
+                Aov::Spp => "camera rays (samples)",
+                _ => "bounces (the deepest reflected or refracted ray)",
+            };
+            (
+                pixels,
+                Some(format!("black 0, white {most} {what} per pixel")),
+            )
+        }
+        Aov::Normal => {
+            for p in &mut pixels {
+                *p = p.map(|c| 0.5 * (c + 1.0));
+            }
+            (pixels, Some("(n + 1)/2 of the unit normal".to_string()))
+        }
+        Aov::Position => {
+            let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
+            for p in &pixels {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
+            }
+            for p in &mut pixels {
+                for k in 0..3 {
+                    let span = hi[k] - lo[k];
+                    p[k] = if span > 0.0 {
+                        (p[k] - lo[k]) / span
+                    } else {
+                        0.0
+                    };
+                }
+            }
+            (
+                pixels,
+                Some(format!("x, y, z from {lo:?} (black) to {hi:?} (full)")),
+            )
+        }
+        Aov::Variance | Aov::Albedo => (pixels, None),
+    }
+}
