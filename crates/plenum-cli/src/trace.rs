@@ -59,21 +59,26 @@ pub fn run(args: TracePixelArgs) -> ExitCode {
         for root in (0..tree.nodes.len()).filter(|&i| tree.nodes[i].parent.is_none()) {
             print_node(&mut out, tree, root, 0);
         }
-        // BDPT: what the listed strategies add up to, here and elsewhere.
+        // BDPT and light tracing: what the listed strategies add up to, here and elsewhere.
         let strategies = tree.nodes.iter().filter_map(|n| Some((n, n.strategy?)));
-        let (mut here, mut elsewhere, mut any) = (Color::BLACK, 0, false);
+        let (mut here, mut splatted_here, mut elsewhere, mut any) =
+            (Color::BLACK, Color::BLACK, 0, false);
         for (n, s) in strategies {
             any = true;
             match s.splat {
                 None => here += n.color,
+                Some([rx, ry]) if (rx.floor(), ry.floor()) == (x as f64, y as f64) => {
+                    splatted_here += n.color
+                }
                 Some(_) => elsewhere += 1,
             }
         }
         if any {
             let _ = writeln!(
                 out,
-                "the strategies of this sample add {} to its pixel; {elsewhere} more land in other pixels (t = 1)",
-                fmt_color(here)
+                "the strategies of this sample add {} to its pixel, and {} more through the film's splats (t = 1); {elsewhere} more land in other pixels",
+                fmt_color(here),
+                fmt_color(splatted_here)
             );
         }
     }

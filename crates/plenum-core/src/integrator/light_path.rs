@@ -115,6 +115,8 @@ pub(super) struct Arrival<'a> {
     pub beta: SampledSpectrum,
     /// Surface vertices from the light, 1 for the first hit.
     pub depth: u32,
+    /// The ray tree's node of the ray that arrived, where a tree is recorded.
+    pub node: Option<usize>,
     /// Only specular bounces since the light (and at least one): a caustic, L S+ D.
     pub caustic: bool,
     /// The path may still make caustics further on: no diffuse or glossy bounce since the
@@ -166,7 +168,13 @@ impl<'a> LightPaths<'a> {
         counts: &mut RayCounts,
         kind: RayKind,
         mut tree: Option<&mut RayTree>,
-        mut arrive: impl FnMut(&Arrival, &SampledWavelengths, &mut SampleStream, &mut RayCounts) -> bool,
+        mut arrive: impl FnMut(
+            &Arrival,
+            &SampledWavelengths,
+            &mut SampleStream,
+            &mut RayCounts,
+            Option<&mut RayTree>,
+        ) -> bool,
     ) {
         let scene = self.scene;
         let mut beta = start.beta;
@@ -205,10 +213,11 @@ impl<'a> LightPaths<'a> {
                     wi: wo,
                     beta,
                     depth,
+                    node: parent,
                     caustic: specular_only && depth > 1,
                     may_continue_caustic: specular_only && flags.is_specular(),
                 };
-                if !arrive(&arrival, wl, stream, counts) {
+                if !arrive(&arrival, wl, stream, counts, tree.as_deref_mut()) {
                     break;
                 }
             }

@@ -19,13 +19,14 @@
 //! so smooth-shaded surfaces receive the light a camera path would find.
 
 use super::light_path::{adjoint_cosine, LightPaths, LightStart};
-use super::{rgb, IntegratorConfig, RayCounts, RayKind, RayTree};
+use super::{rgb, weight_rgb, IntegratorConfig, RayCounts, RayKind, RayNode, RayTree, Strategy};
 use crate::accel::Coherence;
 use crate::bxdf::TransportMode;
 use crate::camera::Camera;
+use crate::color::Color;
 use crate::film::SplatBuffer;
 use crate::light::{EmissionSample, Light};
-use crate::math::{offset_ray_origin, Ray};
+use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::sampling::SampleStream;
 use crate::scene::Scene;
 use plenum_spectrum::{ColorMode, SampledSpectrum, SampledWavelengths};
@@ -62,17 +63,40 @@ impl<'a> LightTracer<'a> {
         wl: &mut SampledWavelengths,
         stream: &mut SampleStream,
         counts: &mut RayCounts,
-        tree: Option<&mut RayTree>,
+        mut tree: Option<&mut RayTree>,
     ) {
         let Some(start) = self.paths.start(wl, stream) else {
             return;
         };
         let LightStart { index, pmf, es, .. } = &start;
         let light = &self.scene.lights[*index as usize];
-        // The light's own point, seen by the camera.
+        // The light's own point, seen by the camera (s = 1, t = 1).
         let u_lens = stream.next_2d();
-        if let Some(l) = self.light_to_camera(light, *index, es, *pmf, u_lens, time, wl, counts) {
-            self.splat(l.0, l.1, wl, counts);
+        if let Some((raster, l, wi)) =
+            self.light_to_camera(light, *index, es, *pmf, u_lens, time, wl, counts)
+        {
+            self.splat(raster, l, wl, counts);
+            if let Some(t) = tree.as_deref_mut() {
+                let added = rgb(l, wl);
+                let mut node = RayNode::new(
+                    None,
+                    RayKind::Connection,
+                    0,
+                    es.ray.origin,
+                    wi,
+                    Color::WHITE,
+                );
+                node.object = Some(self.scene.lights.names[*index as usize].clone());
+                node.color = added;
+                node.strategy = Some(Strategy {
+                    s: 1,
+                    t: 1,
+                    mis_weight: 1.0,
+                    unweighted: added,
+                    splat: Some(raster),
+                });
+                t.push(node);
+            }
         }
         // Every vertex that can scatter toward the lens, joined to a point on it.
         let kind = RayKind::Light;
@@ -84,7 +108,7 @@ impl<'a> LightTracer<'a> {
             counts,
             kind,
             tree,
-            |a, wl, stream, counts| {
+            |a, wl, stream, counts, tree| {
                 let Some(c) = self.camera.sample_wi(a.it.p, stream.next_2d(), time) else {
                     return true;
                 };
@@ -96,20 +120,45 @@ impl<'a> LightTracer<'a> {
                 counts.connection += 1;
                 let origin = offset_ray_origin(a.it.p, a.it.p_error, a.it.n, c.wi);
                 let shadow = Ray::new(origin, c.lens_point - origin).at_time(time);
-                if !self
-                    .scene
-                    .geometry
-                    .occluded(&shadow, 1.0 - 1e-9, Coherence::Incoherent)
-                {
-                    self.splat(c.raster, a.beta * f * (c.we / c.pdf), wl, counts);
+                let blocked =
+                    self.scene
+                        .geometry
+                        .occluded(&shadow, 1.0 - 1e-9, Coherence::Incoherent);
+                let l = a.beta * f * (c.we / c.pdf);
+                if !blocked {
+                    self.splat(c.raster, l, wl, counts);
+                }
+                // The tree lists each join to the lens (s = depth + 1, t = 1) and what it adds
+                // where it lands; a blocked one, the object in its way.
+                if let Some(t) = tree {
+                    let weight = weight_rgb(a.beta, wl);
+                    let mut node =
+                        RayNode::new(a.node, RayKind::Connection, a.depth, a.it.p, c.wi, weight);
+                    node.distance = Some((c.lens_point - a.it.p).length());
+                    if blocked {
+                        let hit = self.scene.geometry.intersect(&shadow, 1.0);
+                        node.object =
+                            hit.map(|(p, _)| self.scene.geometry.names[p as usize].clone());
+                    }
+                    let added = if blocked { Color::BLACK } else { rgb(l, wl) };
+                    node.color = added;
+                    node.strategy = Some(Strategy {
+                        s: a.depth + 1,
+                        t: 1,
+                        mis_weight: 1.0,
+                        unweighted: added,
+                        splat: Some(c.raster),
+                    });
+                    t.push(node);
                 }
                 true
             },
         );
     }
 
-    /// The emitter's sampled point joined to a lens point: its radiance (or intensity)
-    /// toward the lens, times W_e, over the densities. Lights at infinity have no point.
+    /// The emitter's sampled point joined to a lens point: where it lands, its radiance (or
+    /// intensity) toward the lens, times W_e, over the densities, and the direction toward
+    /// the lens. Lights at infinity have no point.
     #[allow(clippy::too_many_arguments)]
     fn light_to_camera(
         &self,
@@ -121,7 +170,7 @@ impl<'a> LightTracer<'a> {
         time: f64,
         wl: &SampledWavelengths,
         counts: &mut RayCounts,
-    ) -> Option<([f64; 2], SampledSpectrum)> {
+    ) -> Option<([f64; 2], SampledSpectrum, Vec3)> {
         if light.is_infinite() || light.is_delta_direction() {
             return None;
         }
@@ -151,7 +200,7 @@ impl<'a> LightTracer<'a> {
             return None;
         }
         let l = self.scene.lights.spectrum(index, wl);
-        Some((c.raster, l * (geometric * c.we / (c.pdf * pmf))))
+        Some((c.raster, l * (geometric * c.we / (c.pdf * pmf)), c.wi))
     }
 
     fn splat(

@@ -130,9 +130,20 @@ impl<'a> PhotonMapper<'a> {
         let scene = self.scene;
         let mut l = SampledSpectrum::ZERO;
         let mut path = EyePath::new(camera_ray);
-        while let Some(v) = path.trace(scene, wl, &mut l, &mut tree) {
+        loop {
+            // The ray tree shows what each vertex adds to the pixel, its final gather apart
+            // (each gather ray's node holds its share).
+            let before = l;
+            let mut gathered_here = SampledSpectrum::ZERO;
+            let added = |l: SampledSpectrum, gathered: SampledSpectrum, wl: &SampledWavelengths| {
+                rgb(l - before - gathered, wl)
+            };
+            let Some(v) = path.trace(scene, wl, &mut l, &mut tree) else {
+                break;
+            };
             let (it, wo, node) = (&v.it, v.wo, v.node);
             let Some(bsdf) = scene.bsdf(it, wo, wl) else {
+                record(&mut tree, node, |n| n.color = added(l, gathered_here, wl));
                 break;
             };
             let (beta, time) = (path.beta, path.ray.time);
@@ -140,6 +151,7 @@ impl<'a> PhotonMapper<'a> {
                 // The last vertex, as the path tracer's: no photon of either map can end a
                 // path here (a photon's first landing is direct light).
                 l += beta * direct::last_vertex_ld(scene, it, wo, &bsdf, wl, stream, counts, time);
+                record(&mut tree, node, |n| n.color = added(l, gathered_here, wl));
                 break;
             }
             // e: the eye vertex, 1 for the camera ray's hit.
@@ -169,17 +181,19 @@ impl<'a> PhotonMapper<'a> {
                 // A smooth coat's own reflection belongs to the traced part.
                 let specular = traced.is_none();
                 let gathered = self.gather(
-                    it, wo, &g, wl, stream, counts, e, time, specular, &mut tree, node,
+                    it, wo, &g, wl, stream, counts, e, time, specular, beta, &mut tree, node,
                 );
-                l += beta * gathered;
-                record(&mut tree, node, |n| n.color = rgb(l, wl));
+                gathered_here = beta * gathered;
+                l += gathered_here;
             }
             let Some(r) = traced else {
+                record(&mut tree, node, |n| n.color = added(l, gathered_here, wl));
                 break;
             };
             if r.flags().is_non_specular() {
                 l += beta * sample_ld(scene, it, wo, &r, wl, stream, counts, time, 1.0);
             }
+            record(&mut tree, node, |n| n.color = added(l, gathered_here, wl));
             let (uc, u) = (stream.next_1d(), stream.next_2d());
             if path.bounce(&v, &r, uc, u, counts, &mut tree).is_none() {
                 break;
@@ -194,6 +208,7 @@ impl<'a> PhotonMapper<'a> {
     /// specular bounces is a caustic (the caustic map's), unless every bounce from the eye
     /// vertex on was specular: that light neither map holds. Without `specular` a gather
     /// ray sampled from a specular lobe counts nothing (the eye path goes on by that lobe).
+    /// `beta`, the eye path's throughput, scales what the ray tree shows of each gather ray.
     #[allow(clippy::too_many_arguments)]
     fn gather(
         &self,
@@ -206,6 +221,7 @@ impl<'a> PhotonMapper<'a> {
         e: u32,
         time: f64,
         specular: bool,
+        beta: SampledSpectrum,
         tree: &mut Option<&mut RayTree>,
         parent: Option<usize>,
     ) -> SampledSpectrum {
@@ -312,7 +328,9 @@ impl<'a> PhotonMapper<'a> {
                 ray =
                     Ray::new(offset_ray_origin(it.p, it.p_error, it.n, bs.wi), bs.wi).at_time(time);
             }
-            record(tree, node, |nd| nd.color = rgb((sum - before) / n, wl));
+            record(tree, node, |nd| {
+                nd.color = rgb(beta * (sum - before) / n, wl)
+            });
         }
         sum / self.gather_rays.max(1) as f64
     }

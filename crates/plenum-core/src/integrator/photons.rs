@@ -67,7 +67,7 @@ impl<'a> PhotonTracer<'a> {
             counts,
             kind,
             None,
-            |a, wl, _, _| arrive(a, wl),
+            |a, wl, _, _, _| arrive(a, wl),
         );
     }
 }
