@@ -7,6 +7,7 @@ mod aov;
 mod bench;
 #[cfg(feature = "embree")]
 mod embree;
+mod figure;
 mod film_file;
 mod memory;
 mod trace;
@@ -257,6 +258,10 @@ struct TracePixelArgs {
     /// Print JSON instead of an indented tree.
     #[arg(long)]
     json: bool,
+    /// Also draw the tree as a figure, to this SVG file: its rays as the camera sees them
+    /// and from the side, coloured and labelled by kind, over the objects they pass.
+    #[arg(long, value_name = "FILE")]
+    svg: Option<PathBuf>,
     /// Which of the pixel's samples to trace, counted from 0 (default 0), or `all`: the
     /// tree then holds every sample's rays and the colour is the pixel's. SPPM, adaptive
     /// subdivision and the SPD corners trace the whole pixel.

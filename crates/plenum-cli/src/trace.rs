@@ -84,6 +84,13 @@ pub fn run(args: TracePixelArgs) -> ExitCode {
     }
     // A reader that stops early (`| head`) is not an error.
     let _ = std::io::stdout().lock().write_all(out.as_bytes());
+    if let Some(path) = &args.svg {
+        let svg = crate::figure::tree_svg(&loaded.scene, &settings, &traced);
+        if let Err(e) = std::fs::write(path, svg) {
+            eprintln!("error: cannot write {}: {e}", path.display());
+            return ExitCode::from(1);
+        }
+    }
     ExitCode::SUCCESS
 }
 

@@ -1730,3 +1730,57 @@ fn the_views_of_where_the_work_goes_add_up_to_the_render() {
         assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
     }
 }
+
+/// `trace-pixel --svg` draws the tree: well-formed SVG, one line per ray of the tree (in
+/// each of its two panels where the camera sees it), titled by kind, a legend of the kinds,
+/// the objects it passes; a file it cannot write is an error, exit 1.
+#[test]
+fn trace_pixel_draws_the_tree_as_a_figure() {
+    let tmp = temp_dir("svg");
+    let dir = tmp.path();
+    let base = [
+        "trace-pixel",
+        "-",
+        "32",
+        "24",
+        "--width",
+        "64",
+        "--height",
+        "48",
+    ];
+    let o = plenum()
+        .current_dir(dir)
+        .args(base)
+        .args(["--json", "--svg", "tree.svg"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let doc: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let rays = doc["rays"].as_array().unwrap().len();
+    let svg = std::fs::read_to_string(dir.join("tree.svg")).unwrap();
+    let xml = roxmltree::Document::parse(&svg).unwrap_or_else(|e| panic!("{e}\n{svg}"));
+    let titled: Vec<String> = xml
+        .descendants()
+        .filter(|n| n.has_tag_name("line"))
+        .filter_map(|n| n.children().find(|c| c.has_tag_name("title")))
+        .filter_map(|t| t.text().map(str::to_string))
+        .filter(|t| t.contains(" ray, depth "))
+        .collect();
+    // The side view shows every ray; the camera's view those in front of the lens.
+    assert!(
+        titled.len() > rays && titled.len() <= 2 * rays,
+        "{rays} rays, {titled:?}"
+    );
+    assert!(titled.iter().any(|t| t.starts_with("refracted ray")));
+    for legend in ["camera ray", "refracted ray", "glass sphere"] {
+        assert!(svg.contains(legend), "no `{legend}` in the figure");
+    }
+    let o = plenum()
+        .current_dir(dir)
+        .args(base)
+        .args(["--svg", "no/such/folder/tree.svg"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("cannot write"), "{}", stderr(&o));
+}

@@ -208,6 +208,17 @@ fn serves_the_page_the_image_and_a_ray_tree() {
             "{s}"
         );
         assert!(rays.iter().skip(1).all(|r| r["segment"].is_array()));
+        // The same tree as a figure for slides (`trace-pixel --svg`).
+        let (status, headers, svg) = request(&view, "GET", "/api/figure?x=24&y=18");
+        assert_eq!(status, 200);
+        assert!(header(&headers, "content-type").starts_with("image/svg+xml"));
+        let svg = String::from_utf8_lossy(&svg);
+        assert!(
+            svg.starts_with("<svg") && svg.contains("refracted ray"),
+            "{svg}"
+        );
+        let (status, v) = json(&view, "GET", "/api/figure?x=99&y=0");
+        assert_eq!(status, 400, "{v}");
         for bad in [
             "/api/trace?x=48&y=0",
             "/api/trace?x=0&y=-1",

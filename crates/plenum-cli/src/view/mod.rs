@@ -11,7 +11,7 @@
 
 mod http;
 
-use crate::trace::{trace, tree_json, SampleArg};
+use crate::trace::{trace, tree_json, SampleArg, Traced};
 use crate::{named, render_settings, whole, Cli, Command, ViewArgs, MAX_THREADS};
 use http::{Request, Response};
 use plenum_core::accel::AccelKind;
@@ -384,10 +384,12 @@ impl Server {
             ("GET", "/api/status") => Response::json(200, &self.status()),
             ("GET", "/api/image") => self.image(),
             ("GET", "/api/trace") => self.trace(r),
+            ("GET", "/api/figure") => self.figure(r),
             ("POST", "/api/render") => self.restart(r),
             (
                 _,
-                "/" | "/index.html" | "/api/status" | "/api/image" | "/api/trace" | "/api/render",
+                "/" | "/index.html" | "/api/status" | "/api/image" | "/api/trace" | "/api/figure"
+                | "/api/render",
             ) => Response::error(405, &format!("{} is not allowed on {}", r.method, r.path)),
             _ => Response::error(404, &format!("nothing at {}", r.path)),
         }
@@ -478,13 +480,49 @@ impl Server {
     /// The ray tree of pixel (x, y) of the render under way (`sample=K`, default 0, or
     /// `all`, as `trace-pixel --sample`), each ray with the segment it draws over the image.
     fn trace(&self, r: &Request) -> Response {
+        let (job, traced) = match self.traced(r) {
+            Ok(t) => t,
+            Err(response) => return response,
+        };
+        let (w, h) = (job.settings.width, job.settings.height);
+        let tree = &traced.tree;
+        let mut doc = tree_json(&traced);
+        let camera = Camera::new(&job.scene.camera, w, h);
+        if let Some(rays) = doc["rays"].as_array_mut() {
+            for (ray, node) in rays.iter_mut().zip(&tree.nodes) {
+                let (end, _) = crate::figure::ray_end(&job.scene, node);
+                ray["segment"] = match camera.project_segment(node.origin, end) {
+                    Some((a, b)) => json!([a, b]),
+                    None => Value::Null,
+                };
+            }
+        }
+        Response::json(200, &doc)
+    }
+
+    /// The ray tree of `/api/trace`'s pixel drawn as `trace-pixel --svg` draws it.
+    fn figure(&self, r: &Request) -> Response {
+        match self.traced(r) {
+            Ok((job, traced)) => Response {
+                status: 200,
+                content_type: "image/svg+xml",
+                body: crate::figure::tree_svg(&job.scene, &job.settings, &traced).into_bytes(),
+                headers: Vec::new(),
+            },
+            Err(response) => response,
+        }
+    }
+
+    /// The job under way and the tree of the pixel `r` asks for (`x`, `y`, `sample`), or
+    /// the error response.
+    fn traced(&self, r: &Request) -> Result<(Arc<Job>, Traced), Response> {
         let Some(job) = self.state().job.clone() else {
-            return Response::error(409, "no render yet");
+            return Err(Response::error(409, "no render yet"));
         };
         let (w, h) = (job.settings.width, job.settings.height);
         let coordinate = |key: &str, size: u32| -> Result<u32, String> {
             let v = r.get(key).ok_or_else(|| {
-                format!("missing `{key}`: expected /api/trace?x=X&y=Y[&sample=K]")
+                format!("missing `{key}`: expected {}?x=X&y=Y[&sample=K]", r.path)
             })?;
             v.parse::<u32>().ok().filter(|&n| n < size).ok_or_else(|| {
                 format!(
@@ -495,36 +533,16 @@ impl Server {
         };
         let (x, y) = match (coordinate("x", w), coordinate("y", h)) {
             (Ok(x), Ok(y)) => (x, y),
-            (Err(e), _) | (_, Err(e)) => return Response::error(400, &e),
+            (Err(e), _) | (_, Err(e)) => return Err(Response::error(400, &e)),
         };
         let sample = match r.get("sample").map(str::parse::<SampleArg>).transpose() {
             Ok(s) => s,
-            Err(e) => return Response::error(400, &format!("`sample`: {e}")),
+            Err(e) => return Err(Response::error(400, &format!("`sample`: {e}"))),
         };
-        let traced = match trace(&job.scene, &job.settings, (x, y), sample) {
-            Ok(t) => t,
-            Err(e) => return Response::error(400, &e),
-        };
-        let tree = &traced.tree;
-        let mut doc = tree_json(&traced);
-        let camera = Camera::new(&job.scene.camera, w, h);
-        // A ray that escaped is drawn far past the scene.
-        let far = 4.0 * job.scene.geometry.radius().max(1e-3);
-        if let Some(rays) = doc["rays"].as_array_mut() {
-            for (ray, node) in rays.iter_mut().zip(&tree.nodes) {
-                let d = node.direction.normalized();
-                let length = node
-                    .distance
-                    .filter(|t| t.is_finite())
-                    .unwrap_or(far + (node.origin - job.scene.camera.position).length());
-                ray["segment"] = match camera.project_segment(node.origin, node.origin + d * length)
-                {
-                    Some((a, b)) => json!([a, b]),
-                    None => Value::Null,
-                };
-            }
+        match trace(&job.scene, &job.settings, (x, y), sample) {
+            Ok(t) => Ok((job, t)),
+            Err(e) => Err(Response::error(400, &e)),
         }
-        Response::json(200, &doc)
     }
 
     /// Restarts the render with the page's settings (`/api/render?spp=16&integrator=path`).
