@@ -1564,17 +1564,26 @@ fn the_variance_aov_is_written_beside_the_image() {
         ),
         (&["-o", "x.plf"][..], "writes an image"),
     ] {
-        let o = plenum()
-            .current_dir(dir)
-            .arg("render")
-            .args(&args)
-            .args(["--aov", "variance"])
-            .args(extra)
-            .output()
-            .unwrap();
-        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
-        assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
+        assert_refused(
+            dir,
+            &[&args[..], &["--aov".into(), "variance".into()]].concat(),
+            extra,
+            says,
+        );
     }
+}
+
+/// `plenum render ARGS EXTRA`, run in `dir`, is refused: exit 2, and the error says `says`.
+fn assert_refused(dir: &Path, args: &[String], extra: &[&str], says: &str) {
+    let o = plenum()
+        .current_dir(dir)
+        .arg("render")
+        .args(args)
+        .args(extra)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
+    assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
 }
 
 /// `--crop` renders a part of the image: in pixels, or in fractions as pbrt's crop window,
@@ -1633,9 +1642,7 @@ fn a_crop_renders_part_of_the_image_as_the_whole_render_does() {
             "integrator `bdpt` cannot render a part of the image",
         ),
     ] {
-        let o = run(extra);
-        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
-        assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
+        assert_refused(dir, &args, extra, says);
     }
 }
 
@@ -1719,15 +1726,7 @@ fn the_views_of_where_the_work_goes_add_up_to_the_render() {
             "not available with integrator `sppm`",
         ),
     ] {
-        let o = plenum()
-            .current_dir(dir)
-            .arg("render")
-            .args(&args)
-            .args(extra)
-            .output()
-            .unwrap();
-        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
-        assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
+        assert_refused(dir, &args, extra, says);
     }
 }
 
