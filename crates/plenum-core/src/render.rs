@@ -669,7 +669,7 @@ fn traced(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrator::{IntegratorConfig, IntegratorKind, PhotonConfig};
+    use crate::integrator::{IntegratorConfig, IntegratorKind, PhotonConfig, RayKind, Stop};
     use crate::kit;
     use crate::sampling::{PixelSampler, SamplerKind};
 
@@ -925,7 +925,8 @@ mod tests {
     /// return (each vertex's emission, light sample and photon estimates) sum to the
     /// sample's value. Light tracing: each sample's joins to the lens, summed where they
     /// land over every sample of every pixel, are the image (box filter). The kit's Cornell
-    /// box, 8 × 8, 4 spp, RGB, seed 6.
+    /// box, 8 × 8, 4 spp, RGB, seed 6. And BDPT's tree shows every light subpath, one whose
+    /// first ray met nothing too (a point light over the kit's floor).
     #[test]
     fn every_methods_ray_tree_adds_up_to_what_it_renders() {
         let scene = kit::cornell_box(true);
@@ -966,12 +967,12 @@ mod tests {
             }
             assert!(lit > 128, "{}: {lit} samples lit", kind.name());
         }
-        let settings = settings(IntegratorKind::Light);
+        let light = settings(IntegratorKind::Light);
         let cancel = AtomicBool::new(false);
-        let image = render(&scene, &settings, &cancel, &|_, _| {}).film;
+        let image = render(&scene, &light, &cancel, &|_, _| {}).film;
         let mut splats = vec![Color::BLACK; 64];
         for (x, y, i) in (0..256).map(|k| (k % 8, (k / 8) % 8, k / 64)) {
-            let (tree, value) = trace_sample(&scene, &settings, x, y, i).unwrap();
+            let (tree, value) = trace_sample(&scene, &light, x, y, i).unwrap();
             assert_eq!(value, Color::BLACK, "light tracing's own estimate");
             for n in &tree.nodes {
                 if let Some([rx, ry]) = n.strategy.and_then(|s| s.splat) {
@@ -990,5 +991,23 @@ mod tests {
             );
         }
         assert!(splats.iter().any(|s| s.max_component() > 0.0));
+        // BDPT's tree shows every sample's light subpath, also one whose first ray left
+        // the scene (half the point light's rays over the kit's floor go up and away).
+        let scene = kit::lamp_over_floor(0.5, true);
+        let bdpt = settings(IntegratorKind::Bdpt);
+        let mut escaped = 0;
+        for i in 0..4 {
+            for (x, y) in [(1, 1), (4, 6), (7, 2), (5, 5)] {
+                let (tree, _) = trace_sample(&scene, &bdpt, x, y, i).unwrap();
+                let light: Vec<_> = tree
+                    .nodes
+                    .iter()
+                    .filter(|n| n.kind == RayKind::Light)
+                    .collect();
+                assert!(!light.is_empty(), "({x}, {y}) sample {i}: no light subpath");
+                escaped += usize::from(light.len() == 1 && light[0].stops.contains(&Stop::Miss));
+            }
+        }
+        assert!(escaped > 0, "no light subpath escaped");
     }
 }

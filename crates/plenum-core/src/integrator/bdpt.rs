@@ -279,9 +279,22 @@ impl<'a> BidirectionalPathTracer<'a> {
         let raster = self.camera.we(ray).map(|(_, r)| r);
         let max_surface = self.max_depth as usize + 1;
         self.camera_subpath(ray, max_surface + 2, wl, stream, counts, camera_path);
-        self.light_subpath(ray.time, max_surface, wl, stream, counts, light_path);
+        let escaped = self.light_subpath(ray.time, max_surface, wl, stream, counts, light_path);
         record_subpath(&mut tree, self.scene, camera_path, RayKind::Camera, wl);
         record_subpath(&mut tree, self.scene, light_path, RayKind::Light, wl);
+        // A light subpath whose first ray met nothing is that ray alone.
+        if let (Some(t), Some(d), [light]) = (tree.as_deref_mut(), escaped, &light_path[..]) {
+            let mut node = RayNode::new(
+                None,
+                RayKind::Light,
+                0,
+                light.p,
+                d,
+                weight_rgb(light.beta, wl),
+            );
+            node.stops.push(Stop::Miss);
+            t.push(node);
+        }
 
         let mut l = SampledSpectrum::ZERO;
         // Emission no light stands for, Phong k_e, by s = 0 alone (the background is a
@@ -392,7 +405,7 @@ impl<'a> BidirectionalPathTracer<'a> {
     }
 
     /// The light subpath: a point on a light chosen by power, then up to `max_vertices`
-    /// surface vertices.
+    /// surface vertices; the direction of its first ray, for the ray tree.
     #[allow(clippy::too_many_arguments)]
     fn light_subpath(
         &self,
@@ -402,7 +415,7 @@ impl<'a> BidirectionalPathTracer<'a> {
         stream: &mut SampleStream,
         counts: &mut RayCounts,
         path: &mut Vec<Vertex>,
-    ) {
+    ) -> Option<Vec3> {
         let scene = self.scene;
         let Some(LightStart {
             index,
@@ -412,7 +425,7 @@ impl<'a> BidirectionalPathTracer<'a> {
             beta,
         }) = start_light_path(scene, (self.center, self.radius), wl, stream)
         else {
-            return;
+            return None;
         };
         let light = &scene.lights[index as usize];
         let mut v = Vertex::endpoint(Kind::Light, es.ray.origin, le);
@@ -450,6 +463,7 @@ impl<'a> BidirectionalPathTracer<'a> {
                 first.pdf_fwd *= es.ray.direction.dot(first.n).abs();
             }
         }
+        Some(es.ray.direction)
     }
 
     /// Extends `path` by up to `max_vertices` vertices from `ray`, scattering by the BSDFs
