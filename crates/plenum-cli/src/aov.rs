@@ -1,8 +1,9 @@
 //! `--aov`: images beside the render, each to NAME.VIEW.EXT beside NAME.EXT. Where the
-//! work goes (`rays`, `spp`, `depth`), what the camera's rays first meet (`normal`, `albedo`,
-//! `position`), and how noisy each pixel is (`variance`). Float formats keep the values;
-//! a PNG shows them (counts scaled so that the largest is white, normals as (n + 1)/2,
-//! positions across their bounding box).
+//! work goes (`rays`, `spp`, `depth`, and `cost`: the acceleration structures' node visits,
+//! primitive tests and their sum as red, green and blue), what the camera's rays first meet
+//! (`normal`, `albedo`, `position`), and how noisy each pixel is (`variance`). Float formats
+//! keep the values; a PNG shows them (counts scaled so that the largest is white, the cost
+//! in false colour, normals as (n + 1)/2, positions across their bounding box).
 
 use crate::FILM_EXTENSION;
 use plenum_core::aov::first_hits;
@@ -19,17 +20,19 @@ pub enum Aov {
     Rays,
     Spp,
     Depth,
+    Cost,
     Normal,
     Albedo,
     Position,
 }
 
 impl Aov {
-    const ALL: [Aov; 7] = [
+    const ALL: [Aov; 8] = [
         Aov::Variance,
         Aov::Rays,
         Aov::Spp,
         Aov::Depth,
+        Aov::Cost,
         Aov::Normal,
         Aov::Albedo,
         Aov::Position,
@@ -41,6 +44,7 @@ impl Aov {
             Aov::Rays => "rays",
             Aov::Spp => "spp",
             Aov::Depth => "depth",
+            Aov::Cost => "cost",
             Aov::Normal => "normal",
             Aov::Albedo => "albedo",
             Aov::Position => "position",
@@ -79,7 +83,9 @@ impl AovList {
 
     /// Whether the render must keep each pixel's rays.
     pub fn needs_pixel_rays(&self) -> bool {
-        self.has(Aov::Rays) || self.has(Aov::Spp) || self.has(Aov::Depth)
+        [Aov::Rays, Aov::Spp, Aov::Depth, Aov::Cost]
+            .iter()
+            .any(|&a| self.has(a))
     }
 
     /// Why these views cannot go with `settings`, if they cannot: `keeps_film` (checkpoints,
@@ -107,13 +113,13 @@ impl AovList {
         }
         if self.needs_pixel_rays() {
             if kind == IntegratorKind::Sppm {
-                return Err("--aov rays, spp and depth are not available with integrator `sppm`: its photon passes belong to no pixel".to_string());
+                return Err("--aov rays, spp, depth and cost are not available with integrator `sppm`: its photon passes belong to no pixel".to_string());
             }
             if settings.corners {
-                return Err("--aov rays, spp and depth are not available with the SPD corners: each corner ray belongs to four pixels".to_string());
+                return Err("--aov rays, spp, depth and cost are not available with the SPD corners: each corner ray belongs to four pixels".to_string());
             }
             if keeps_film {
-                return Err("--aov rays, spp and depth cannot be combined with checkpoints, --time-limit or --samples: the rays of each pixel are not kept in the film".to_string());
+                return Err("--aov rays, spp, depth and cost cannot be combined with checkpoints, --time-limit or --samples: the rays of each pixel are not kept in the film".to_string());
             }
         }
         Ok(())
@@ -154,6 +160,14 @@ impl AovList {
                 Aov::Rays => counts(|r| r.total),
                 Aov::Spp => counts(|r| r.camera),
                 Aov::Depth => counts(|r| r.deepest),
+                Aov::Cost => rendered
+                    .pixel_rays
+                    .iter()
+                    .map(|r| {
+                        let (n, t) = (r.cost.nodes as f32, r.cost.tests as f32);
+                        [n, t, n + t]
+                    })
+                    .collect(),
                 Aov::Normal => hits.as_ref().map_or(Vec::new(), |h| h.normal.clone()),
                 Aov::Albedo => hits.as_ref().map_or(Vec::new(), |h| h.albedo.clone()),
                 Aov::Position => hits.as_ref().map_or(Vec::new(), |h| h.position.clone()),
@@ -232,6 +246,41 @@ fn for_png(aov: Aov, mut pixels: Vec<[f32; 3]>) -> (Vec<[f32; 3]>, Option<String
                 Some(format!("x, y, z from {lo:?} (black) to {hi:?} (full)")),
             )
         }
+        Aov::Cost => {
+            let most = pixels.iter().map(|p| p[2]).fold(0.0f32, f32::max);
+            for p in &mut pixels {
+                *p = heat(if most > 0.0 { p[2] / most } else { 0.0 });
+            }
+            (
+                pixels,
+                Some(format!(
+                    "false colour from black (0) through blue, red and yellow to white ({most} node visits and primitive tests per pixel)"
+                )),
+            )
+        }
         Aov::Variance | Aov::Albedo => (pixels, None),
     }
+}
+
+/// The colour of `t` in 0..=1 on a heat scale, black, blue, red, yellow, white (as linear
+/// values: the PNG encodes them as sRGB, which shows the scale's own colours).
+pub fn heat(t: f32) -> [f32; 3] {
+    const STOPS: [[f32; 3]; 5] = [
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [1.0, 1.0, 1.0],
+    ];
+    let x = t.clamp(0.0, 1.0) * (STOPS.len() - 1) as f32;
+    let i = (x as usize).min(STOPS.len() - 2);
+    let f = x - i as f32;
+    std::array::from_fn(|k| {
+        let srgb = STOPS[i][k] + (STOPS[i + 1][k] - STOPS[i][k]) * f;
+        if srgb <= 0.04045 {
+            srgb / 12.92
+        } else {
+            ((srgb + 0.055) / 1.055).powf(2.4)
+        }
+    })
 }

@@ -1194,7 +1194,7 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
     if !args.quiet {
         let c = &output.counts;
         eprintln!(
-            "loaded in {:.3} s; {}×{}, {}, {:.3} s, {} ({}), rays: {}; {:.2} Mrays/s → {}",
+            "loaded in {:.3} s; {}×{}, {}, {:.3} s, {} ({}), rays: {}; {:.2} Mrays/s; {}: {} node visits, {} primitive tests → {}",
             load_seconds,
             film_image.width,
             film_image.height,
@@ -1218,6 +1218,9 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
             },
             ray_summary(c),
             c.total() as f64 / elapsed / 1e6,
+            args.accel,
+            c.cost.nodes,
+            c.cost.tests,
             args.output.display()
         );
     }

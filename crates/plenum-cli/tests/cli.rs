@@ -1646,11 +1646,13 @@ fn a_crop_renders_part_of_the_image_as_the_whole_render_does() {
     }
 }
 
-/// `--aov rays,spp,depth,normal,albedo,position` beside the image: the rays per pixel add
-/// up to the summary line's (camera, shadow, reflection, refraction), the camera rays per
-/// pixel are the samples, the deepest bounce within `max_depth`; the first-hit views are of the image's size, the normals unit length,
-/// the albedo within [0, 1]; a PNG's view says what its white stands for. An unknown view,
-/// and rays under SPPM, are refused, exit 2.
+/// `--aov rays,spp,depth,cost,normal,albedo,position` beside the image: the rays per pixel
+/// add up to the summary line's (camera, shadow, reflection, refraction), the camera rays
+/// per pixel are the samples, the deepest bounce within `max_depth`, the node visits and
+/// primitive tests per pixel add up to the summary line's; the first-hit views are of the
+/// image's size, the normals unit length, the albedo within [0, 1]; a PNG's view says what
+/// its white (or its false colour) stands for. An unknown view, and rays under SPPM, are
+/// refused, exit 2.
 #[test]
 fn the_views_of_where_the_work_goes_add_up_to_the_render() {
     let tmp = temp_dir("views");
@@ -1664,7 +1666,7 @@ fn the_views_of_where_the_work_goes_add_up_to_the_render() {
         .arg("render")
         .args(&args)
         .args(["--integrator", "path", "--max-depth", "5"])
-        .args(["--aov", "rays,spp,depth,normal,albedo,position"])
+        .args(["--aov", "rays,spp,depth,cost,normal,albedo,position"])
         .args(["-o", "out.pfm"])
         .output()
         .unwrap();
@@ -1686,6 +1688,17 @@ fn the_views_of_where_the_work_goes_add_up_to_the_render() {
     let per_pixel: f64 = rays.pixels.iter().map(|p| p[0] as f64).sum();
     assert_eq!(per_pixel, summary, "{err}");
     assert!(read("spp").pixels.iter().all(|p| p[0] == 4.0));
+    // The cost view: node visits, primitive tests and their sum, summing to the summary's.
+    let said = |what: &str| -> f64 {
+        let before = err.split(what).next().unwrap();
+        before.rsplit(' ').next().unwrap().parse().unwrap()
+    };
+    let cost = read("cost");
+    let channel = |k: usize| -> f64 { cost.pixels.iter().map(|p| p[k] as f64).sum() };
+    let (nodes, tests) = (said(" node visits"), said(" primitive tests"));
+    assert!(nodes > 0.0 && tests > 0.0, "{err}");
+    assert_eq!((channel(0), channel(1)), (nodes, tests), "{err}");
+    assert_eq!(channel(2), nodes + tests);
     let depth = read("depth");
     assert!(depth
         .pixels
@@ -1709,7 +1722,7 @@ fn the_views_of_where_the_work_goes_add_up_to_the_render() {
         .current_dir(dir)
         .arg("render")
         .args(&args)
-        .args(["--aov", "rays,normal", "-o", "out.png"])
+        .args(["--aov", "rays,normal,cost", "-o", "out.png"])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
@@ -1719,6 +1732,11 @@ fn the_views_of_where_the_work_goes_add_up_to_the_render() {
         stderr(&o)
     );
     assert_eq!(image_size(&dir.join("out.normal.png")), (12, 12));
+    assert!(
+        stderr(&o).contains("out.cost.png: false colour from black (0)"),
+        "{}",
+        stderr(&o)
+    );
     for (extra, says) in [
         (&["--aov", "rays,depht"][..], "unknown view `depht`"),
         (

@@ -318,11 +318,12 @@ impl Tiles<'_> {
                         let before = tile_counts;
                         // The deepest ray is the most, not a sum: the pixel's own, kept apart.
                         tile_counts.deepest = 0;
-                        pixel(*x + ox, *y + oy, s, &mut tile_counts);
+                        tile_counts.charging(|c| pixel(*x + ox, *y + oy, s, c));
                         if keep_rays {
                             rays.camera = tile_counts.camera - before.camera;
                             rays.total = tile_counts.total() - before.total();
                             rays.deepest = tile_counts.deepest;
+                            rays.cost = tile_counts.cost - before.cost;
                         }
                         tile_counts.deepest = tile_counts.deepest.max(before.deepest);
                     }
@@ -336,6 +337,7 @@ impl Tiles<'_> {
                                 kept[i].camera += rays.camera;
                                 kept[i].total += rays.total;
                                 kept[i].deepest = kept[i].deepest.max(rays.deepest);
+                                kept[i].cost += rays.cost;
                             }
                         }
                     }
@@ -669,6 +671,7 @@ fn traced(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::accel::Cost;
     use crate::integrator::{IntegratorConfig, IntegratorKind, PhotonConfig, RayKind, Stop};
     use crate::kit;
     use crate::sampling::{PixelSampler, SamplerKind};
@@ -820,8 +823,9 @@ mod tests {
         assert!(outside.check().is_err());
     }
 
-    /// Each pixel's rays, kept when asked: they add up to the render's counts less the
-    /// photon pass (photon mapping), the camera rays to the samples taken, the deepest
+    /// Each pixel's rays, kept when asked: they and their cost to the acceleration
+    /// structures add up to the render's counts less the photon pass (photon mapping), the
+    /// camera rays to the samples taken, the deepest
     /// bounce to the render's (its `max_depth` in a closed box, under path tracing and
     /// BDPT), for a fixed sampler, adaptive sampling by variance and adaptive subdivision,
     /// and a crop keeps the whole render's there (the kit's Cornell box, 10 × 8, seed 4).
@@ -881,6 +885,17 @@ mod tests {
             };
             assert_eq!(total, out.counts.total() - pass, "{what}");
             assert_eq!(camera, out.counts.camera, "{what}");
+            // The acceleration structures' cost: the photon pass's belongs to no pixel.
+            let cost = out
+                .pixel_rays
+                .iter()
+                .fold(Cost::default(), |c, r| c + r.cost);
+            assert!(cost.nodes > 0 && cost.tests > 0, "{what}");
+            if pass == 0 {
+                assert_eq!(cost, out.counts.cost, "{what}");
+            } else {
+                assert!(cost.nodes < out.counts.cost.nodes, "{what}");
+            }
             let deepest = out.pixel_rays.iter().map(|r| r.deepest).max();
             assert_eq!(deepest, Some(out.counts.deepest), "{what}");
             let max_depth = settings.integrator.max_depth as u64;

@@ -5,6 +5,7 @@
 //! Plain data with the checks of their values, below both the render loop
 //! ([`crate::render`]) and the integrators ([`crate::integrator`]), which both read it.
 
+use crate::accel::{cost, Cost};
 use crate::film::Film;
 use crate::raw_film::RawFilm;
 use crate::sampling::{Filter, PixelSampler};
@@ -241,6 +242,8 @@ pub struct RayCounts {
     /// camera ray's is 0; the BSDF ray of a path's last vertex, which ends it, does not
     /// count): the most, not a sum, which [`RayCounts::add`] keeps.
     pub deepest: u64,
+    /// What the rays cost the acceleration structures: nodes visited, primitives tested.
+    pub cost: Cost,
 }
 
 impl RayCounts {
@@ -264,6 +267,16 @@ impl RayCounts {
         self.photon += o.photon;
         self.invalid += o.invalid;
         self.deepest = self.deepest.max(o.deepest);
+        self.cost += o.cost;
+    }
+
+    /// Runs `work` on this thread, adding the acceleration structures' cost it spends to
+    /// `cost` (work that calls into the thread pool would be charged what it steals).
+    pub fn charging<R>(&mut self, work: impl FnOnce(&mut RayCounts) -> R) -> R {
+        let before = cost::so_far();
+        let r = work(self);
+        self.cost += cost::so_far() - before;
+        r
     }
 
     /// Notes a reflected or refracted ray of depth `depth` on a camera path.
@@ -306,6 +319,8 @@ pub struct PixelRays {
     /// The depth of the deepest reflected or refracted ray of its camera paths
     /// ([`RayCounts::deepest`]).
     pub deepest: u64,
+    /// What its rays cost the acceleration structures ([`RayCounts::cost`]).
+    pub cost: Cost,
 }
 
 /// A part of the image: the pixel columns `x0..x1` and rows `y0..y1`.

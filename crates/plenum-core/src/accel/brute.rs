@@ -46,10 +46,12 @@ impl BruteForce {
             return;
         }
         let mut t_max = t_max;
+        let mut visits = super::cost::Visits::start();
         for (i, &(c, r2)) in self.spheres.iter().enumerate() {
             if r2 < 0.0 {
                 continue;
             }
+            visits.nodes += 1;
             // Closest approach of the ray's line to the centre.
             let oc = c - ray.origin;
             let t_closest = oc.dot(d) / dd;

@@ -346,6 +346,7 @@ impl Grid {
             return;
         };
         let walk = Walk::new(self, ray, inv_dir);
+        let mut visits = super::cost::Visits::start();
         let mut limit = t_max.min(t_exit);
         // The cell walk starts only in a macro cell that holds anything (most rays enter
         // the region through empty ones).
@@ -375,6 +376,7 @@ impl Grid {
                 let mut c = self.index(cell);
                 // Walk the cells until the ray leaves the macro cell along axis `a`.
                 let a = loop {
+                    visits.nodes += 1;
                     debug_assert!(c + 1 < self.starts.len());
                     // SAFETY: `c` indexes the cell `cell`, inside the grid (checked after
                     // each step), and `starts` has one more entry than there are cells.
@@ -423,6 +425,7 @@ impl Grid {
                 stop[a] = self.stop(block[a], a, &walk);
                 m = m.wrapping_add_signed(walk.macro_stride[a]);
             } else {
+                visits.nodes += 1;
                 let (a, t) = nearest(block_next);
                 if t > limit {
                     return;

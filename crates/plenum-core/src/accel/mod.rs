@@ -10,6 +10,7 @@
 
 mod brute;
 mod bvh;
+pub mod cost;
 mod grid;
 mod mailbox;
 mod octree;
@@ -21,6 +22,7 @@ pub use brute::BruteForce;
 pub use bvh::{
     AmongNodes, Bvh, Coherence, LeafItems, LeafPlaces, SahCost, EMBED_LIMIT, EMBED_UNIT,
 };
+pub use cost::Cost;
 pub use grid::Grid;
 pub use octree::Octree;
 
@@ -389,6 +391,44 @@ mod tests {
         assert!(!octree.capped());
         let grid = Accel::build(AccelKind::Grid, &floor, LeafSize::SINGLE);
         assert!(!grid.capped());
+    }
+
+    /// Each walk counts the nodes it visits on its thread: brute force a bounding sphere per
+    /// item, whatever the ray; a BVH one node for a ray that misses the root's children; a
+    /// grid and an octree none for a ray that misses their region. A ray down a row of 64
+    /// cubes that stops at the first hit costs the structures a few visits, brute force 64.
+    #[test]
+    fn walks_count_the_nodes_they_visit() {
+        let cubes: Vec<Bounds3> = (0..64)
+            .map(|i| cube(Vec3::new(i as f64 * 3.0, 0.0, 0.0), 1.0))
+            .collect();
+        let along = Ray::new(Vec3::new(-5.0, 0.0, 0.0), Vec3::X);
+        let beside = Ray::new(Vec3::new(-5.0, 1000.0, 0.0), Vec3::X);
+        for kind in AccelKind::ALL {
+            let accel = Accel::build(kind, &cubes, LeafSize::SINGLE);
+            let visits = |ray: &Ray| {
+                let ((), spent) = cost::spent(|| {
+                    accel.traverse(ray, f64::INFINITY, |items, t_max| {
+                        // The first cube's near face is the nearest hit.
+                        if items.contains(&0) {
+                            *t_max = 4.0;
+                        }
+                        true
+                    })
+                });
+                assert_eq!(spent.tests, 0, "{kind:?}: the callers count the tests");
+                spent.nodes
+            };
+            let (hit, missed) = (visits(&along), visits(&beside));
+            match kind {
+                AccelKind::None => assert_eq!((hit, missed), (64, 64)),
+                AccelKind::Bvh => assert_eq!(missed, 1),
+                _ => assert_eq!(missed, 0, "{kind:?}"),
+            }
+            if kind != AccelKind::None {
+                assert!((1..=12).contains(&hit), "{kind:?}: {hit} visits");
+            }
+        }
     }
 
     #[test]

@@ -454,7 +454,9 @@ impl Octree {
         // The cell entered: its index, planes' distances, and where the ray enters it ahead
         // of its origin. Every cell entered is one the ray crosses before `t_max`.
         let (mut index, mut c0, mut c1, mut start) = (0u32, t0, t1, larger(enter, 0.0));
+        let mut visits = super::cost::Visits::start();
         loop {
+            visits.nodes += 1;
             let node = self.node(index as usize);
             if node.info & LEAF != 0 {
                 let first = node.first as usize;

@@ -508,27 +508,29 @@ fn photon_pass(
         .map(|c| {
             let mut photons = Vec::new();
             let mut counts = RayCounts::default();
-            for i in c * CHUNK..((c + 1) * CHUNK).min(paths) {
-                let mut stream = PhotonTracer::stream(seed, pass, i);
-                let mut wl = super::sample_wavelengths(color, &mut stream);
-                let time = camera.time(stream.next_1d());
-                tracer.trace(time, &mut wl, &mut stream, &mut counts, |a, wl| {
-                    if caustic && !a.caustic {
-                        return a.may_continue_caustic;
-                    }
-                    let power = rgb(a.beta * scale, wl);
-                    if power.r.is_finite() && power.g.is_finite() && power.b.is_finite() {
-                        photons.push(Photon::new(
-                            f32s(a.it.p),
-                            f32s(a.wi),
-                            f32s(a.it.n),
-                            [power.r as f32, power.g as f32, power.b as f32],
-                            a.depth.min(u16::MAX as u32) as u16,
-                        ));
-                    }
-                    !caustic || a.may_continue_caustic
-                });
-            }
+            counts.charging(|counts| {
+                for i in c * CHUNK..((c + 1) * CHUNK).min(paths) {
+                    let mut stream = PhotonTracer::stream(seed, pass, i);
+                    let mut wl = super::sample_wavelengths(color, &mut stream);
+                    let time = camera.time(stream.next_1d());
+                    tracer.trace(time, &mut wl, &mut stream, counts, |a, wl| {
+                        if caustic && !a.caustic {
+                            return a.may_continue_caustic;
+                        }
+                        let power = rgb(a.beta * scale, wl);
+                        if power.r.is_finite() && power.g.is_finite() && power.b.is_finite() {
+                            photons.push(Photon::new(
+                                f32s(a.it.p),
+                                f32s(a.wi),
+                                f32s(a.it.n),
+                                [power.r as f32, power.g as f32, power.b as f32],
+                                a.depth.min(u16::MAX as u32) as u16,
+                            ));
+                        }
+                        !caustic || a.may_continue_caustic
+                    });
+                }
+            });
             (photons, counts)
         })
         .collect();

@@ -185,7 +185,7 @@ impl WholeImage for Sppm {
                 .enumerate()
                 .fold(RayCounts::default, |mut c, (i, px)| {
                     let (x, y) = (i as u32 % w, i as u32 / w);
-                    eye.camera_path(x + ox, y + oy, px, &mut c, None);
+                    c.charging(|c| eye.camera_path(x + ox, y + oy, px, c, None));
                     c
                 })
                 .reduce(RayCounts::default, add_counts);
@@ -199,36 +199,38 @@ impl WholeImage for Sppm {
                 .into_par_iter()
                 .map(|chunk| {
                     let mut c = RayCounts::default();
-                    for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(photons) {
-                        let mut stream = PhotonTracer::stream(settings.seed, iteration, index);
-                        let mut photon_wl = wl;
-                        let time = camera.time(stream.next_1d());
-                        tracer.trace(time, &mut photon_wl, &mut stream, &mut c, |a, pwl| {
-                            if a.depth < 2 {
-                                return true;
-                            }
-                            for &i in grid_now.near(a.it.p) {
-                                let px = &pixels_now[i as usize];
-                                let Some(phi) = px.vp.as_ref().and_then(|vp| {
-                                    vp.photon_flux(px.stats.radius, a, pwl, max_depth)
-                                }) else {
-                                    continue;
-                                };
-                                let s = &sums[i as usize];
-                                for (sum, v) in s.phi.iter().zip([phi.r, phi.g, phi.b]) {
-                                    let units = (v / UNIT).round();
-                                    if units.is_finite() && units != 0.0 {
-                                        sum.fetch_add(
-                                            units.clamp(-9e18, 9e18) as i64,
-                                            Ordering::Relaxed,
-                                        );
-                                    }
+                    c.charging(|c| {
+                        for index in chunk * CHUNK..((chunk + 1) * CHUNK).min(photons) {
+                            let mut stream = PhotonTracer::stream(settings.seed, iteration, index);
+                            let mut photon_wl = wl;
+                            let time = camera.time(stream.next_1d());
+                            tracer.trace(time, &mut photon_wl, &mut stream, c, |a, pwl| {
+                                if a.depth < 2 {
+                                    return true;
                                 }
-                                s.m.fetch_add(1, Ordering::Relaxed);
-                            }
-                            true
-                        });
-                    }
+                                for &i in grid_now.near(a.it.p) {
+                                    let px = &pixels_now[i as usize];
+                                    let Some(phi) = px.vp.as_ref().and_then(|vp| {
+                                        vp.photon_flux(px.stats.radius, a, pwl, max_depth)
+                                    }) else {
+                                        continue;
+                                    };
+                                    let s = &sums[i as usize];
+                                    for (sum, v) in s.phi.iter().zip([phi.r, phi.g, phi.b]) {
+                                        let units = (v / UNIT).round();
+                                        if units.is_finite() && units != 0.0 {
+                                            sum.fetch_add(
+                                                units.clamp(-9e18, 9e18) as i64,
+                                                Ordering::Relaxed,
+                                            );
+                                        }
+                                    }
+                                    s.m.fetch_add(1, Ordering::Relaxed);
+                                }
+                                true
+                            });
+                        }
+                    });
                     c
                 })
                 .reduce(RayCounts::default, add_counts);

@@ -2,7 +2,7 @@
 //! of a ray, the hits of a shadow ray, and where they are in world space.
 
 use super::primitive::{Interaction, Primitive};
-use crate::accel::{Accel, AccelKind, Coherence, LeafSize};
+use crate::accel::{cost, Accel, AccelKind, Coherence, LeafSize};
 use crate::camera::Camera;
 use crate::geometry::{HitRecord, Shape, TriangleMesh};
 use crate::math::{Bounds3, Ray, Vec3};
@@ -62,6 +62,7 @@ impl Geometry {
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<(u32, HitRecord)> {
         let mut best = None;
         self.accel.traverse(ray, t_max, |items, t_max| {
+            cost::tested(items.len());
             for &i in items {
                 let prim = self.bounded[i as usize];
                 if let Some(hit) = self.primitives[prim as usize].intersect(ray, *t_max) {
@@ -71,6 +72,7 @@ impl Geometry {
             }
             true
         });
+        cost::tested(self.unbounded.len());
         for &i in &self.unbounded {
             let limit = best.map_or(t_max, |(_, h)| h.t);
             if let Some(hit) = self.primitives[i as usize].intersect(ray, limit) {
@@ -92,6 +94,7 @@ impl Geometry {
         mut visit: impl FnMut(u32, &HitRecord) -> bool,
     ) {
         let hit_of = |prim: u32| {
+            cost::tested(1);
             let p = &self.primitives[prim as usize];
             if self.transmissive[prim as usize] {
                 p.intersect(ray, t_max)

@@ -2,6 +2,7 @@
 //! a shadow ray, with a fixed-size stack and the children fetched ahead of their test.
 
 use super::{is_leaf, leaf_run, Bvh, MAX_DEPTH, WIDTH};
+use crate::accel::cost;
 #[cfg(target_arch = "x86_64")]
 use crate::accel::ray_f32::BoxRayAvx;
 use crate::accel::ray_f32::{round_up_distance, BoxRay};
@@ -155,6 +156,7 @@ impl Bvh {
         // A reference widened once where it is read: kept as u32, it is widened again
         // before every use as an offset.
         let mut current = 0usize;
+        let mut visits = cost::Visits::start();
         loop {
             if is_leaf(current as u32) {
                 let (start, count) = leaf_run(current as u32);
@@ -169,6 +171,7 @@ impl Bvh {
                 }
             } else {
                 let node = self.node_at(current);
+                visits.nodes += 1;
                 let (near, hits) = test(&node.planes, far);
                 // Eight lanes: indices below stay under eight.
                 let mut hits = hits & node.used & 0xFF;

@@ -10,7 +10,9 @@ use crate::accel::ray_f32::round_up_distance;
 #[cfg(target_arch = "x86_64")]
 use crate::accel::simd::F8;
 use crate::accel::simd::{Avx, Lanes, F4};
-use crate::accel::{bytes_of, Accel, AmongNodes, Coherence, LeafItems, LeafPlaces, EMBED_UNIT};
+use crate::accel::{
+    bytes_of, cost, Accel, AmongNodes, Coherence, LeafItems, LeafPlaces, EMBED_UNIT,
+};
 use crate::geometry::HitRecord;
 use crate::math::Ray;
 use std::ops::Range;
@@ -71,6 +73,7 @@ impl TriangleMesh {
                     let state = &mut search;
                     let visit_run = move |run: Range<usize>, t_max: &mut f64| {
                         let (block, count) = (first(state, &run), run.end - run.start);
+                        cost::tested(count);
                         // SAFETY: `avx` says the CPU has AVX.
                         unsafe { self.search_leaf_avx::<NEAREST>(avx, block, count, t_max, state) }
                     };
@@ -79,6 +82,7 @@ impl TriangleMesh {
                 }
                 let visit_run = |run: Range<usize>, t_max: &mut f64| {
                     let (block, count) = (first(&search, &run), run.end - run.start);
+                    cost::tested(count);
                     self.search_run_sse::<NEAREST, true>(block, 0..count, t_max, &mut search)
                 };
                 traverse_bvh::<NEAREST>(bvh, ray, t_max, AmongNodes, coherence, visit_run);
@@ -100,6 +104,7 @@ impl TriangleMesh {
     fn search_cells<const NEAREST: bool>(&self, ray: &Ray, t_max: f64, search: &mut Search) {
         // Their runs are of slots, block after block from the first.
         let visit_run = |run: Range<usize>, t_max: &mut f64| {
+            cost::tested(run.len());
             // SAFETY: the runs are of the blocks' slots.
             let first = unsafe { self.blocks.as_ptr().add(run.start / LANES) };
             self.search_run::<NEAREST, true>(first, 0..run.len(), t_max, search)
@@ -112,6 +117,7 @@ impl TriangleMesh {
             Accel::Grid(grid) => grid.traverse_runs(ray, t_max, visit_run),
             Accel::Octree(octree) => octree.traverse_runs(ray, t_max, visit_run),
             Accel::None(brute) => brute.traverse(ray, t_max, |items, t_max| {
+                cost::tested(items.len());
                 items.iter().all(|&slot| {
                     let (block, lane) = (slot as usize / LANES, slot as usize % LANES);
                     // SAFETY: brute force names the slots of the blocks.
