@@ -1,6 +1,7 @@
 //! `plenum view` in a real browser: headless Chromium loads the page, which draws the image
 //! and, asked by its address (`#trace=X,Y`), the ray tree of the glass sphere's middle pixel
-//! with its rays over the image; the DOM it leaves is checked and a screenshot kept.
+//! with its rays over the image and in the 3-D view, and (`#show=cost`) the cost view; the
+//! DOM it leaves is checked and a screenshot kept.
 //!
 //! Skipped, saying so, where Chromium is not installed, unless PLENUM_REQUIRE_BROWSER=1
 //! (`.ci/run` installs Debian's `chromium` and sets it), where that fails the test.
@@ -91,8 +92,6 @@ fn the_page_shows_the_image_and_a_pixels_ray_tree() {
     let dom = headless(browser, &["--dump-dom".to_string()], &url);
     let shot = std::env::temp_dir().join(format!("plenum-view-{}.png", std::process::id()));
     let _ = headless(browser, &[format!("--screenshot={}", shot.display())], &url);
-    let _ = view.kill();
-    let _ = view.wait();
 
     assert!(
         dom.contains("data-image-version="),
@@ -114,6 +113,31 @@ fn the_page_shows_the_image_and_a_pixels_ray_tree() {
         svg.matches("<line").count() >= 3,
         "no rays drawn over the image: {svg}"
     );
+    // The 3-D view draws the scene's objects and the tree's rays.
+    let space = &dom[dom.find("id=\"space\"").unwrap()..];
+    let space = &space[..space.find('>').unwrap()];
+    let count = |attribute: &str| -> usize {
+        let at = space
+            .find(&format!("{attribute}=\""))
+            .unwrap_or_else(|| panic!("no {attribute}: {space}"));
+        let rest = &space[at + attribute.len() + 2..];
+        rest[..rest.find('"').unwrap()].parse().unwrap()
+    };
+    assert!(count("data-objects") >= 3, "{space}");
+    assert!(count("data-segments") >= 3, "{space}");
+    // The cost view in false colour, with its scale.
+    let dom = headless(
+        browser,
+        &["--dump-dom".to_string()],
+        &format!("{base}#show=cost"),
+    );
+    assert!(dom.contains("data-shown=\"cost\""), "no cost view:\n{dom}");
+    assert!(
+        dom.contains("node visits + primitive tests per pixel"),
+        "{dom}"
+    );
+    let _ = view.kill();
+    let _ = view.wait();
     let png = std::fs::read(&shot).expect("Chromium wrote no screenshot");
     assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000);
     eprintln!("screenshot: {}", shot.display());

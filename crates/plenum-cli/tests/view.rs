@@ -233,6 +233,105 @@ fn serves_the_page_the_image_and_a_ray_tree() {
     }
 }
 
+/// The views of where the work goes (`/api/view`): rays and cost per pixel that add up to
+/// the status's counters, the samples per pixel, brute force costing more than the BVH;
+/// none under SPPM, an unknown view refused. The scene for the 3-D view (`/api/scene`):
+/// every object outlined and named, the camera's frustum, the lights; the trace's rays
+/// carry their 3-D ends.
+#[test]
+fn shows_where_the_work_goes_and_the_scene_in_3d() {
+    let view = start(&[
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--spp",
+        "4",
+        "--integrator",
+        "path",
+    ]);
+    let values = |name: &str| -> (Vec<f64>, u64) {
+        let (status, headers, body) = request(&view, "GET", &format!("/api/view?name={name}"));
+        assert_eq!(status, 200, "{name}: {}", String::from_utf8_lossy(&body));
+        assert_eq!(
+            (header(&headers, "x-width"), header(&headers, "x-height")),
+            ("32", "24")
+        );
+        let v: Vec<f64> = body
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]) as f64)
+            .collect();
+        assert_eq!(v.len(), 32 * 24);
+        (v, header(&headers, "x-max").parse().unwrap())
+    };
+    let mut costs = Vec::new();
+    for accel in ["bvh", "none"] {
+        let (status, _) = json(&view, "POST", &format!("/api/render?accel={accel}"));
+        assert_eq!(status, 200);
+        let st = wait_for(&view, "finished", |st| {
+            finished(st) && st["settings"]["accel"] == accel
+        });
+        let (rays, most) = values("rays");
+        assert_eq!(
+            rays.iter().sum::<f64>(),
+            st["rays"].as_f64().unwrap(),
+            "{st}"
+        );
+        assert_eq!(rays.iter().cloned().fold(0.0, f64::max), most as f64);
+        assert!(values("spp").0.iter().all(|&n| n == 4.0));
+        let cost: f64 = values("cost").0.iter().sum();
+        let counted = st["node_visits"].as_f64().unwrap() + st["primitive_tests"].as_f64().unwrap();
+        assert_eq!(cost, counted, "{st}");
+        costs.push(cost);
+    }
+    assert!(
+        costs[1] > 1.5 * costs[0],
+        "brute force {} against the BVH {}",
+        costs[1],
+        costs[0]
+    );
+    let (status, v) = json(&view, "GET", "/api/view?name=bogus");
+    assert_eq!(status, 400);
+    assert!(v["error"]
+        .as_str()
+        .unwrap()
+        .contains("unknown view `bogus`"));
+
+    let (status, scene) = json(&view, "GET", "/api/scene");
+    assert_eq!(status, 200);
+    let objects = scene["objects"].as_array().unwrap();
+    assert!(
+        objects.iter().any(|o| o["name"] == "glass sphere"),
+        "{scene}"
+    );
+    for o in objects {
+        let lines = o["lines"].as_array().unwrap();
+        assert!(!lines.is_empty(), "{o}");
+        assert!(lines.iter().flat_map(|l| l.as_array().unwrap()).all(|p| p
+            .as_array()
+            .unwrap()
+            .len()
+            == 3));
+    }
+    assert_eq!(scene["camera"]["corners"].as_array().unwrap().len(), 4);
+    assert!(!scene["lights"].as_array().unwrap().is_empty(), "{scene}");
+    let (_, tree) = json(&view, "GET", "/api/trace?x=16&y=12");
+    assert!(tree["rays"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|r| r["end"].as_array().is_some_and(|e| e.len() == 3)));
+
+    let (status, _) = json(&view, "POST", "/api/render?integrator=sppm");
+    assert_eq!(status, 200);
+    wait_for(&view, "finished", |st| {
+        finished(st) && st["settings"]["integrator"] == "sppm"
+    });
+    let (status, v) = json(&view, "GET", "/api/view?name=rays");
+    assert_eq!(status, 409);
+    assert!(v["error"].as_str().unwrap().contains("no one pixel"), "{v}");
+}
+
 /// A new setting restarts the render (cancelling a long one within a second or so), a bad
 /// one is refused with the option's own error and leaves the render be; unknown paths,
 /// methods, settings and malformed requests get an error each; many clients at once are

@@ -334,10 +334,7 @@ impl Tiles<'_> {
                             f.pixels[i] = s;
                             f.stages[i] = stage;
                             if let Some(kept) = kept.as_deref_mut() {
-                                kept[i].camera += rays.camera;
-                                kept[i].total += rays.total;
-                                kept[i].deepest = kept[i].deepest.max(rays.deepest);
-                                kept[i].cost += rays.cost;
+                                kept[i].add(&rays);
                             }
                         }
                     }

@@ -323,6 +323,16 @@ pub struct PixelRays {
     pub cost: Cost,
 }
 
+impl PixelRays {
+    /// Adds the rays of more of the pixel's samples (the deepest is the most of both).
+    pub fn add(&mut self, o: &PixelRays) {
+        self.camera += o.camera;
+        self.total += o.total;
+        self.deepest = self.deepest.max(o.deepest);
+        self.cost += o.cost;
+    }
+}
+
 /// A part of the image: the pixel columns `x0..x1` and rows `y0..y1`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Crop {

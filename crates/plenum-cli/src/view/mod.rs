@@ -1,5 +1,7 @@
 //! `plenum view`: a page in the browser that shows the render as it forms, restarts it with
-//! other settings, and shows the ray tree of a clicked pixel over the image.
+//! other settings, shows where the work goes (rays, samples, depth and the acceleration
+//! structures' cost per pixel), and shows the ray tree of a clicked pixel over the image and
+//! in a 3-D view of the scene's outlines (`outline.rs`) that the mouse orbits.
 //!
 //! One process: the HTTP server answers each connection on a thread of its own, the render
 //! runs on a worker thread (its tiles on the render pool), and a watcher re-renders when the
@@ -10,6 +12,7 @@
 //! SPD corners, which cannot be split so, show their film as it fills.
 
 mod http;
+mod outline;
 
 use crate::trace::{trace, tree_json, SampleArg, Traced};
 use crate::{named, render_settings, whole, Cli, Command, ViewArgs, MAX_THREADS};
@@ -19,7 +22,7 @@ use plenum_core::camera::Camera;
 use plenum_core::integrator::{whole_image, ColorMode, IntegratorKind, RayCounts};
 use plenum_core::raw_film::RawFilm;
 use plenum_core::render::{new_film, render_film};
-use plenum_core::render::{RenderControl, RenderSettings};
+use plenum_core::render::{PixelRays, RenderControl, RenderSettings};
 use plenum_core::sampling::FilterKind;
 use plenum_core::scene::Scene;
 use plenum_scene::{builtin_scene_with, load_scene_with};
@@ -99,6 +102,9 @@ struct State {
     image: Option<Arc<Snapshot>>,
     /// Bumped by every image published.
     version: u64,
+    /// Each pixel's rays and their cost so far, summed over the passes done (none for
+    /// SPPM and the SPD corners, whose rays belong to no one pixel).
+    rays: Option<Arc<Vec<PixelRays>>>,
     samples_done: u32,
     /// Tiles of the pass under way: (done, in all).
     tiles: (usize, usize),
@@ -228,8 +234,10 @@ impl Server {
         for w in &loaded.warnings {
             eprintln!("{w}");
         }
-        let settings =
+        let mut settings =
             render_settings(&args.view, &mut loaded).map_err(|e| format!("error: {e}"))?;
+        // The page's views of where the work goes.
+        settings.pixel_rays = true;
         Ok(Job {
             scene: loaded.scene,
             settings,
@@ -253,6 +261,7 @@ impl Server {
             s.tiles = (0, 0);
             s.pass_samples = 0;
             s.counts = RayCounts::default();
+            s.rays = None;
             s.started = Some(Instant::now());
             s.finished = None;
         }
@@ -296,7 +305,18 @@ impl Server {
                 };
                 render_film(&job.scene, settings, &mut film, control)
             });
-            self.state().counts.add(&out.counts);
+            {
+                let mut s = self.state();
+                s.counts.add(&out.counts);
+                if out.complete && !out.pixel_rays.is_empty() {
+                    let mut rays = s.rays.as_deref().cloned().unwrap_or_default();
+                    rays.resize(out.pixel_rays.len(), PixelRays::default());
+                    for (sum, r) in rays.iter_mut().zip(&out.pixel_rays) {
+                        sum.add(r);
+                    }
+                    s.rays = Some(Arc::new(rays));
+                }
+            }
             if !out.complete {
                 return;
             }
@@ -385,11 +405,13 @@ impl Server {
             ("GET", "/api/image") => self.image(),
             ("GET", "/api/trace") => self.trace(r),
             ("GET", "/api/figure") => self.figure(r),
+            ("GET", "/api/scene") => self.scene(),
+            ("GET", "/api/view") => self.view(r),
             ("POST", "/api/render") => self.restart(r),
             (
                 _,
                 "/" | "/index.html" | "/api/status" | "/api/image" | "/api/trace" | "/api/figure"
-                | "/api/render",
+                | "/api/scene" | "/api/view" | "/api/render",
             ) => Response::error(405, &format!("{} is not allowed on {}", r.method, r.path)),
             _ => Response::error(404, &format!("nothing at {}", r.path)),
         }
@@ -439,6 +461,8 @@ impl Server {
             "spp": spp,
             "progress": if running { ((s.samples_done as f64 + pass) / spp.max(1) as f64).min(1.0) } else { 1.0 },
             "rays": rays,
+            "node_visits": s.counts.cost.nodes,
+            "primitive_tests": s.counts.cost.tests,
             "mrays_per_s": if elapsed > 0.0 { rays as f64 / elapsed / 1e6 } else { 0.0 },
             "elapsed": elapsed,
             "error": s.error,
@@ -477,6 +501,72 @@ impl Server {
         }
     }
 
+    /// The scene's outlines, camera and lights for the 3-D view ([`outline::scene_json`]).
+    fn scene(&self) -> Response {
+        let Some(job) = self.state().job.clone() else {
+            return Response::error(409, "no render yet");
+        };
+        let (w, h) = (job.settings.width, job.settings.height);
+        Response::json(200, &outline::scene_json(&job.scene, w, h))
+    }
+
+    /// A view of where the work goes (`name=rays|spp|depth|cost`), over the passes done:
+    /// one little-endian f32 per pixel, row by row, with the image's size and the largest
+    /// value in the headers. The cost is node visits plus primitive tests.
+    fn view(&self, r: &Request) -> Response {
+        const NAMES: [&str; 4] = ["rays", "spp", "depth", "cost"];
+        let name = r.get("name").unwrap_or("");
+        let value: fn(&PixelRays) -> u64 = match name {
+            "rays" => |p| p.total,
+            "spp" => |p| p.camera,
+            "depth" => |p| p.deepest,
+            "cost" => |p| p.cost.nodes + p.cost.tests,
+            _ => {
+                return Response::error(
+                    400,
+                    &format!(
+                        "unknown view `{name}`: expected name={}",
+                        NAMES.join(", name=")
+                    ),
+                )
+            }
+        };
+        let (job, rays) = {
+            let s = self.state();
+            (s.job.clone(), s.rays.clone())
+        };
+        let Some(job) = job else {
+            return Response::error(409, "no render yet");
+        };
+        let kind = job.settings.integrator.kind;
+        let Some(rays) = rays else {
+            let why = if kind == IntegratorKind::Sppm || job.settings.corners {
+                "its rays belong to no one pixel (SPPM's photon passes, the SPD corners)"
+            } else {
+                "no pass has finished yet"
+            };
+            return Response::error(409, &format!("no view of the work: {why}"));
+        };
+        let (w, h) = job.settings.image_size();
+        let mut body = Vec::with_capacity(rays.len() * 4);
+        let mut most = 0;
+        for p in rays.iter() {
+            let v = value(p);
+            most = most.max(v);
+            body.extend_from_slice(&(v as f32).to_le_bytes());
+        }
+        Response {
+            status: 200,
+            content_type: "application/octet-stream",
+            body,
+            headers: vec![
+                ("X-Width", w.to_string()),
+                ("X-Height", h.to_string()),
+                ("X-Max", most.to_string()),
+            ],
+        }
+    }
+
     /// The ray tree of pixel (x, y) of the render under way (`sample=K`, default 0, or
     /// `all`, as `trace-pixel --sample`), each ray with the segment it draws over the image.
     fn trace(&self, r: &Request) -> Response {
@@ -491,6 +581,7 @@ impl Server {
         if let Some(rays) = doc["rays"].as_array_mut() {
             for (ray, node) in rays.iter_mut().zip(&tree.nodes) {
                 let (end, _) = crate::figure::ray_end(&job.scene, node);
+                ray["end"] = json!([end.x, end.y, end.z]);
                 ray["segment"] = match camera.project_segment(node.origin, end) {
                     Some((a, b)) => json!([a, b]),
                     None => Value::Null,
