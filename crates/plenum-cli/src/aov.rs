@@ -125,7 +125,8 @@ impl AovList {
         Ok(())
     }
 
-    /// Writes each view beside `output`; the lines that say what a PNG's white stands for.
+    /// Writes each view beside `output`; the lines that say what a PNG's white stands for
+    /// (`most`, where given, for the counts; else each view's largest).
     pub fn write(
         &self,
         output: &Path,
@@ -133,6 +134,7 @@ impl AovList {
         rendered: &RenderOutput,
         scene: &Scene,
         settings: &RenderSettings,
+        most: Option<u64>,
     ) -> Result<Vec<String>, String> {
         let png = output
             .extension()
@@ -173,7 +175,7 @@ impl AovList {
                 Aov::Position => hits.as_ref().map_or(Vec::new(), |h| h.position.clone()),
             };
             let pixels = if png {
-                let (shown, note) = for_png(aov, pixels);
+                let (shown, note) = for_png(aov, pixels, most.map(|m| m as f32));
                 if let Some(n) = note {
                     notes.push(format!("{}: {n}", path.display()));
                 }
@@ -198,13 +200,21 @@ pub fn aov_path(output: &Path, view: &str) -> PathBuf {
 
 /// A view as a PNG shows it (linear values, which the PNG encodes as sRGB), and what its
 /// white stands for where that is not 1.
-fn for_png(aov: Aov, mut pixels: Vec<[f32; 3]>) -> (Vec<[f32; 3]>, Option<String>) {
+fn for_png(
+    aov: Aov,
+    mut pixels: Vec<[f32; 3]>,
+    most: Option<f32>,
+) -> (Vec<[f32; 3]>, Option<String>) {
+    // The full scale: as asked, else the largest of channel `k`.
+    let full = |pixels: &[[f32; 3]], k: usize| {
+        most.unwrap_or_else(|| pixels.iter().map(|p| p[k]).fold(0.0f32, f32::max))
+    };
     match aov {
         Aov::Rays | Aov::Spp | Aov::Depth => {
-            let most = pixels.iter().map(|p| p[0]).fold(0.0f32, f32::max);
+            let most = full(&pixels, 0);
             if most > 0.0 {
                 for p in &mut pixels {
-                    *p = p.map(|c| c / most);
+                    *p = p.map(|c| (c / most).min(1.0));
                 }
             }
             let what = match aov {
@@ -247,7 +257,7 @@ fn for_png(aov: Aov, mut pixels: Vec<[f32; 3]>) -> (Vec<[f32; 3]>, Option<String
             )
         }
         Aov::Cost => {
-            let most = pixels.iter().map(|p| p[2]).fold(0.0f32, f32::max);
+            let most = full(&pixels, 2);
             for p in &mut pixels {
                 *p = heat(if most > 0.0 { p[2] / most } else { 0.0 });
             }
@@ -264,7 +274,7 @@ fn for_png(aov: Aov, mut pixels: Vec<[f32; 3]>) -> (Vec<[f32; 3]>, Option<String
 
 /// The colour of `t` in 0..=1 on a heat scale, black, blue, red, yellow, white (as linear
 /// values: the PNG encodes them as sRGB, which shows the scale's own colours).
-pub fn heat(t: f32) -> [f32; 3] {
+fn heat(t: f32) -> [f32; 3] {
     const STOPS: [[f32; 3]; 5] = [
         [0.0, 0.0, 0.0],
         [0.0, 0.0, 1.0],

@@ -188,13 +188,20 @@ struct RenderArgs {
     /// Also write these views beside the output NAME.EXT, each to NAME.VIEW.EXT
     /// (comma-separated): `rays` (rays traced per pixel, of every kind), `spp` (camera
     /// rays per pixel: the samples adaptive sampling took), `depth` (the deepest bounce of
-    /// its camera paths), `normal`, `albedo` and `position` (what the pixel's camera rays
-    /// first meet, the mean over its samples), and `variance` (each pixel's variance of its value from its own samples, what a z-test
-    /// of one render against a reference needs; not for light tracing, BDPT or SPPM, whose
-    /// pixels are not their own samples' mean, nor for adaptive subdivision or the SPD
-    /// corners). A PNG shows a view scaled; EXR and PFM keep its values.
+    /// its camera paths), `cost` (the acceleration structures' node visits, primitive tests
+    /// and their sum), `normal`, `albedo` and `position` (what the pixel's camera rays
+    /// first meet, the mean over its samples), and `variance` (each pixel's variance of its
+    /// value from its own samples, what a z-test of one render against a reference needs;
+    /// not for light tracing, BDPT or SPPM, whose pixels are not their own samples' mean,
+    /// nor for adaptive subdivision or the SPD corners). A PNG shows a view scaled; EXR and
+    /// PFM keep its values.
     #[arg(long, value_name = "VIEWS")]
     aov: Option<aov::AovList>,
+    /// The count a PNG view of rays, spp, depth or cost shows at full scale (white, or the
+    /// cost's top colour), so that several renders' views share one scale. Default: each
+    /// view's largest.
+    #[arg(long, value_name = "COUNT", allow_negative_numbers = true, value_parser = whole::<u64>(1, u64::MAX))]
+    aov_max: Option<u64>,
     /// Save the render's state to this film file (.plf) every --checkpoint-every seconds
     /// and when it is stopped (Ctrl-C, --time-limit); `--resume FILE` continues it. Removed
     /// once the image is written.
@@ -996,6 +1003,9 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
         return refuse(e);
     }
     settings.pixel_rays = views.needs_pixel_rays();
+    if args.aov_max.is_some() && !views.needs_pixel_rays() {
+        return refuse("--aov-max sets the scale of the views of counts: give it with --aov rays, spp, depth or cost".to_string());
+    }
     if keeps_film && settings.integrator.strategies {
         return refuse("--write-strategies cannot be combined with checkpoints, --time-limit, --samples or film output: the strategy images are not kept in the film".to_string());
     }
@@ -1155,7 +1165,14 @@ fn run_render(mut args: RenderArgs) -> ExitCode {
         }
         return ExitCode::from(1);
     }
-    match views.write(&args.output, &film, &output, &loaded.scene, &settings) {
+    match views.write(
+        &args.output,
+        &film,
+        &output,
+        &loaded.scene,
+        &settings,
+        args.aov_max,
+    ) {
         Ok(notes) => {
             if !args.quiet {
                 for n in notes {

@@ -1722,12 +1722,19 @@ fn the_views_of_where_the_work_goes_add_up_to_the_render() {
         .current_dir(dir)
         .arg("render")
         .args(&args)
-        .args(["--aov", "rays,normal,cost", "-o", "out.png"])
+        .args([
+            "--aov",
+            "rays,normal,cost",
+            "--aov-max",
+            "5000",
+            "-o",
+            "out.png",
+        ])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("out.rays.png: black 0, white"),
+        stderr(&o).contains("out.rays.png: black 0, white 5000 rays per pixel"),
         "{}",
         stderr(&o)
     );
@@ -1739,6 +1746,14 @@ fn the_views_of_where_the_work_goes_add_up_to_the_render() {
     );
     for (extra, says) in [
         (&["--aov", "rays,depht"][..], "unknown view `depht`"),
+        (
+            &["--aov", "normal", "--aov-max", "9"][..],
+            "--aov-max sets the scale",
+        ),
+        (
+            &["--aov", "rays", "--aov-max", "0"][..],
+            "expected a whole number ≥ 1",
+        ),
         (
             &["--aov", "rays", "--integrator", "sppm"][..],
             "not available with integrator `sppm`",
@@ -1800,4 +1815,34 @@ fn trace_pixel_draws_the_tree_as_a_figure() {
         .unwrap();
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("cannot write"), "{}", stderr(&o));
+}
+
+/// docs/tutorial.sh makes every picture and tree docs/tutorial.md shows (run small here:
+/// 32 × 24, the ladder at 16 × 16, into a temporary folder), and each is in docs/tutorial.
+#[test]
+fn the_tutorials_script_makes_every_picture_it_shows() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let tmp = temp_dir("tutorial");
+    let o = Command::new("bash")
+        .arg(root.join("docs/tutorial.sh"))
+        .arg(env!("CARGO_BIN_EXE_plenum"))
+        .envs([("W", "32"), ("H", "24"), ("LADDER", "16")])
+        .env("OUT", tmp.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let page = std::fs::read_to_string(root.join("docs/tutorial.md")).unwrap();
+    let shown: Vec<&str> = page
+        .split("](tutorial/")
+        .skip(1)
+        .map(|rest| &rest[..rest.find(')').unwrap()])
+        .collect();
+    assert!(shown.len() > 40, "{shown:?}");
+    for name in shown {
+        assert!(tmp.path().join(name).is_file(), "the script makes no {name}");
+        assert!(
+            root.join("docs/tutorial").join(name).is_file(),
+            "docs/tutorial/{name} is not there: run docs/tutorial.sh"
+        );
+    }
 }
