@@ -1,9 +1,11 @@
-//! `--aov`: images beside the render, each to NAME.VIEW.EXT beside NAME.EXT. Where the
+//! `--aov`: images beside the render, each to NAME.VIEW.EXT beside NAME.EXT (or, for an EXR,
+//! in it as its layers). Where the
 //! work goes (`rays`, `spp`, `depth`, and `cost`: the acceleration structures' node visits,
 //! primitive tests and their sum as red, green and blue), what the camera's rays first meet
 //! (`normal`, `albedo`, `position`), and how noisy each pixel is (`variance`). Float formats
-//! keep the values; a PNG shows them (counts scaled so that the largest is white, the cost
-//! in false colour, normals as (n + 1)/2, positions across their bounding box).
+//! keep the values (an EXR's layers are named NAME.CHANNEL); a PNG shows them
+//! (counts scaled so that the largest is white, the cost in false colour, normals as
+//! (n + 1)/2, positions across their bounding box).
 
 use crate::FILM_EXTENSION;
 use plenum_core::aov::first_hits;
@@ -11,6 +13,7 @@ use plenum_core::integrator::IntegratorKind;
 use plenum_core::raw_film::RawFilm;
 use plenum_core::render::{Adaptive, RenderOutput, RenderSettings};
 use plenum_core::scene::Scene;
+use plenum_image::ExrLayer;
 use std::path::{Path, PathBuf};
 
 /// One view.
@@ -136,9 +139,13 @@ impl AovList {
         settings: &RenderSettings,
         most: Option<u64>,
     ) -> Result<Vec<String>, String> {
-        let png = output
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        let is = |ext: &str| {
+            output
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+        };
+        let (png, exr) = (is("png"), is("exr"));
+        let mut layers = Vec::new();
         let hits = [Aov::Normal, Aov::Albedo, Aov::Position]
             .iter()
             .any(|&a| self.has(a))
@@ -174,6 +181,10 @@ impl AovList {
                 Aov::Albedo => hits.as_ref().map_or(Vec::new(), |h| h.albedo.clone()),
                 Aov::Position => hits.as_ref().map_or(Vec::new(), |h| h.position.clone()),
             };
+            if exr {
+                layers.push(exr_layer(aov, &pixels));
+                continue;
+            }
             let pixels = if png {
                 let (shown, note) = for_png(aov, pixels, most.map(|m| m as f32));
                 if let Some(n) = note {
@@ -185,7 +196,39 @@ impl AovList {
             };
             plenum_image::write_image(&path, w, h, &pixels, 0.0).map_err(|e| e.to_string())?;
         }
+        if !layers.is_empty() {
+            // The image again, with the views as its layers.
+            let f = &rendered.film;
+            plenum_image::write_exr_layers(output, f.width, f.height, f.pixels(), &layers)
+                .map_err(|e| e.to_string())?;
+            let names: Vec<String> = layers
+                .iter()
+                .map(|l| {
+                    let channels: Vec<&str> = l.channels.iter().map(|c| c.0).collect();
+                    format!("{}.{}", l.name, channels.join("/"))
+                })
+                .collect();
+            notes.push(format!(
+                "{}: the views are its layers {}",
+                output.display(),
+                names.join(", ")
+            ));
+        }
         Ok(notes)
+    }
+}
+
+/// A view as an EXR layer: counts as one channel, Y; the cost as node visits, tests and
+/// their sum in R, G and B (as in a file of its own); the rest as R, G, B.
+fn exr_layer(aov: Aov, pixels: &[[f32; 3]]) -> ExrLayer {
+    let channel = |k: usize| pixels.iter().map(|p| p[k]).collect::<Vec<f32>>();
+    let channels = match aov {
+        Aov::Rays | Aov::Spp | Aov::Depth => vec![("Y", channel(0))],
+        _ => vec![("R", channel(0)), ("G", channel(1)), ("B", channel(2))],
+    };
+    ExrLayer {
+        name: aov.name().to_string(),
+        channels,
     }
 }
 

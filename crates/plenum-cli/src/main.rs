@@ -193,8 +193,8 @@ struct RenderArgs {
     /// first meet, the mean over its samples), and `variance` (each pixel's variance of its
     /// value from its own samples, what a z-test of one render against a reference needs;
     /// not for light tracing, BDPT or SPPM, whose pixels are not their own samples' mean,
-    /// nor for adaptive subdivision or the SPD corners). A PNG shows a view scaled; EXR and
-    /// PFM keep its values.
+    /// nor for adaptive subdivision or the SPD corners). A PNG shows a view scaled; PFM
+    /// keeps its values; an EXR output holds the views as its layers (VIEW.CHANNEL).
     #[arg(long, value_name = "VIEWS")]
     aov: Option<aov::AovList>,
     /// The count a PNG view of rays, spp, depth or cost shows at full scale (white, or the

@@ -1718,6 +1718,37 @@ fn the_views_of_where_the_work_goes_add_up_to_the_render() {
         .flatten()
         .all(|c| (0.0..=1.0001).contains(c)));
     assert_eq!(read("position").pixels.len(), 144);
+    // An EXR holds the views as its layers, the image as its R, G, B.
+    let o = plenum()
+        .current_dir(dir)
+        .arg("render")
+        .args(&args)
+        .args(["--integrator", "path", "--max-depth", "5"])
+        .args(["--aov", "rays,cost,normal", "-o", "out.exr"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("out.exr: the views are its layers rays.Y, cost.R/G/B, normal.R/G/B"),
+        "{}",
+        stderr(&o)
+    );
+    let (w, h, channels) = plenum_image::read_exr_channels(&dir.join("out.exr")).unwrap();
+    assert_eq!((w, h), (12, 12));
+    let channel = |n: &str| -> f64 {
+        let c = channels
+            .iter()
+            .find(|c| c.0 == n)
+            .unwrap_or_else(|| panic!("no {n}"));
+        c.1.iter().map(|&v| v as f64).sum()
+    };
+    assert_eq!(channel("rays.Y"), summary);
+    // The same render as the PFM's: the same rays, the same cost.
+    assert_eq!((channel("cost.R"), channel("cost.G")), (nodes, tests));
+    let image = plenum_image::read_float_image(&dir.join("out.exr")).unwrap();
+    let pfm = plenum_image::read_float_image(&dir.join("out.pfm")).unwrap();
+    assert_eq!(image.pixels, pfm.pixels, "the same render's image");
+    assert!(!dir.join("out.rays.exr").exists());
     let o = plenum()
         .current_dir(dir)
         .arg("render")
@@ -1839,7 +1870,10 @@ fn the_tutorials_script_makes_every_picture_it_shows() {
         .collect();
     assert!(shown.len() > 40, "{shown:?}");
     for name in shown {
-        assert!(tmp.path().join(name).is_file(), "the script makes no {name}");
+        assert!(
+            tmp.path().join(name).is_file(),
+            "the script makes no {name}"
+        );
         assert!(
             root.join("docs/tutorial").join(name).is_file(),
             "docs/tutorial/{name} is not there: run docs/tutorial.sh"

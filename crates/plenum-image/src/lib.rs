@@ -130,6 +130,84 @@ pub fn write_image(
     }
 }
 
+/// Views beside an EXR's image, each written as OpenEXR's layers within one part are: its
+/// channels named `NAME.CHANNEL` (`rays.Y`, `normal.R`, …), which viewers and compositors
+/// (Blender, Nuke, the OpenEXR tools) group under NAME.
+pub struct ExrLayer {
+    pub name: String,
+    /// Each channel's name and values, row-major from the top-left.
+    pub channels: Vec<(&'static str, Vec<f32>)>,
+}
+
+/// Writes `pixels` (linear RGB) and `layers` to an OpenEXR file at `path`: 32-bit float
+/// channels R, G and B and NAME.CHANNEL for each layer's, compressed losslessly.
+pub fn write_exr_layers(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 3]],
+    layers: &[ExrLayer],
+) -> Result<(), ImageError> {
+    use exr::prelude::*;
+    let wrap = |e: Box<dyn std::error::Error + Send + Sync>| ImageError::Write {
+        path: path.display().to_string(),
+        source: e,
+    };
+    let size = (width as usize, height as usize);
+    let area = size.0 * size.1;
+    if pixels.len() != area
+        || layers
+            .iter()
+            .flat_map(|l| &l.channels)
+            .any(|c| c.1.len() != area)
+    {
+        return Err(wrap("pixel count does not match the size".into()));
+    }
+    let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+    for (k, name) in ["R", "G", "B"].into_iter().enumerate() {
+        let values = pixels.iter().map(|p| p[k]).collect();
+        channels.push(AnyChannel::new(name, FlatSamples::F32(values)));
+    }
+    for layer in layers {
+        for (channel, values) in &layer.channels {
+            let name = format!("{}.{channel}", layer.name);
+            channels.push(AnyChannel::new(
+                name.as_str(),
+                FlatSamples::F32(values.clone()),
+            ));
+        }
+    }
+    let layer = Layer::new(
+        size,
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(channels),
+    );
+    Image::from_layer(layer)
+        .write()
+        .to_file(path)
+        .map_err(|e| wrap(e.into()))
+}
+
+/// The channels of an OpenEXR file's first part by name, each row-major from the top-left,
+/// with the image's width and height.
+pub fn read_exr_channels(path: &Path) -> Result<(u32, u32, Vec<(String, Vec<f32>)>), ImageError> {
+    let image =
+        exr::prelude::read_first_flat_layer_from_file(path).map_err(|e| ImageError::Read {
+            path: path.display().to_string(),
+            source: e.into(),
+        })?;
+    let size = image.layer_data.size;
+    let channels = image
+        .layer_data
+        .channel_data
+        .list
+        .iter()
+        .map(|c| (c.name.to_string(), c.sample_data.values_as_f32().collect()))
+        .collect();
+    Ok((size.0 as u32, size.1 as u32, channels))
+}
+
 /// PFM: a text header "PF\nW H\n-1.0\n" (negative scale: little-endian), then float RGB rows
 /// from the bottom of the image up.
 fn write_pfm(path: &Path, width: u32, height: u32, pixels: &[[f32; 3]]) -> std::io::Result<()> {
@@ -574,5 +652,39 @@ mod tests {
                 let _ = parse_pfm(&bytes);
             }
         }
+    }
+
+    /// An EXR with layers: the image as R, G, B, which every reader (the `image` crate's
+    /// included) takes as the image, and each layer's channels as NAME.CHANNEL, read back
+    /// exactly.
+    #[test]
+    fn an_exr_carries_its_views_as_layers() {
+        let path = temp_dir("layers").join("t.exr");
+        let pixels = [[1.0, 2.0, 3.0], [0.5, 0.25, 0.125]];
+        let layers = [
+            ExrLayer {
+                name: "rays".into(),
+                channels: vec![("Y", vec![7.0, 9.0])],
+            },
+            ExrLayer {
+                name: "normal".into(),
+                channels: vec![
+                    ("R", vec![0.0, 1.0]),
+                    ("G", vec![1.0, 0.0]),
+                    ("B", vec![0.0, -1.0]),
+                ],
+            },
+        ];
+        write_exr_layers(&path, 2, 1, &pixels, &layers).unwrap();
+        let image = read_float_image(&path).unwrap();
+        assert_eq!(image.pixels, pixels.to_vec());
+        let (w, h, channels) = read_exr_channels(&path).unwrap();
+        assert_eq!((w, h), (2, 1));
+        let get = |n: &str| channels.iter().find(|c| c.0 == n).map(|c| c.1.clone());
+        assert_eq!(get("rays.Y"), Some(vec![7.0, 9.0]));
+        assert_eq!(get("normal.B"), Some(vec![0.0, -1.0]));
+        assert_eq!(get("G"), Some(vec![2.0, 0.25]));
+        assert_eq!(channels.len(), 7);
+        assert!(write_exr_layers(&path, 3, 1, &pixels, &layers).is_err());
     }
 }
