@@ -3,11 +3,17 @@
 //! with its rays over the image and in the 3-D view, and (`#show=cost`) the cost view; the
 //! DOM it leaves is checked and a screenshot kept.
 //!
-//! Skipped, saying so, where Chromium is not installed, unless PLENUM_REQUIRE_BROWSER=1
-//! (`.ci/run` installs Debian's `chromium` and sets it), where that fails the test.
+//! And driven as a user drives it, through ChromeDriver (WebDriver): the page loaded, the
+//! glass sphere clicked, the tree, the overlay and the 3-D view awaited, a screenshot kept.
+//!
+//! Skipped, saying so, where Chromium (or ChromeDriver) is not installed, unless
+//! PLENUM_REQUIRE_BROWSER=1 (`.ci/run` installs Debian's `chromium` and `chromium-driver`
+//! and sets it), where that fails the test.
 
-use std::io::{BufRead, BufReader};
-use std::process::{Command, Stdio};
+use serde_json::{json, Value};
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::{TcpListener, TcpStream};
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 fn chromium() -> Option<&'static str> {
@@ -141,4 +147,238 @@ fn the_page_shows_the_image_and_a_pixels_ray_tree() {
     let png = std::fs::read(&shot).expect("Chromium wrote no screenshot");
     assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000);
     eprintln!("screenshot: {}", shot.display());
+}
+
+/// A child process killed when dropped (the test's server and driver, however it ends).
+struct Killed(Child);
+
+impl Drop for Killed {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// `plenum view` started with `args`, and the address it prints.
+fn start_view(args: &[&str]) -> (Killed, String) {
+    let mut view = Command::new(env!("CARGO_BIN_EXE_plenum"))
+        .arg("view")
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(view.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let base = line.split_whitespace().last().unwrap().to_string();
+    (Killed(view), base)
+}
+
+/// One WebDriver command: `method` on `path` of the driver at `port` with a JSON body; the
+/// reply's `value`.
+fn webdriver(port: u16, method: &str, path: &str, body: Option<Value>) -> Value {
+    let body = body.map(|b| b.to_string()).unwrap_or_default();
+    let mut s = TcpStream::connect(("127.0.0.1", port)).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
+    write!(
+        s,
+        "{method} {path} HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n{body}",
+        body.len()
+    )
+    .unwrap();
+    // The driver keeps the connection open: read the headers, then Content-Length bytes.
+    let mut reply = Vec::new();
+    let mut byte = [0u8; 1];
+    while !reply.ends_with(b"\r\n\r\n") {
+        assert_eq!(
+            s.read(&mut byte).unwrap(),
+            1,
+            "{method} {path}: the driver hung up"
+        );
+        reply.push(byte[0]);
+    }
+    let head = String::from_utf8_lossy(&reply).to_ascii_lowercase();
+    let length: usize = head
+        .lines()
+        .find_map(|l| l.strip_prefix("content-length:"))
+        .map(|v| v.trim().parse().unwrap())
+        .unwrap_or_else(|| panic!("{method} {path}: no length in {head}"));
+    let mut text = vec![0u8; length];
+    s.read_exact(&mut text).unwrap();
+    let text = String::from_utf8_lossy(&text);
+    let v: Value =
+        serde_json::from_str(&text).unwrap_or_else(|e| panic!("{method} {path}: {e}: {text}"));
+    v["value"].clone()
+}
+
+/// Standard base64, as the WebDriver screenshot comes.
+fn base64_decode(s: &str) -> Vec<u8> {
+    let value = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        _ => 63,
+    };
+    let digits: Vec<u8> = s
+        .bytes()
+        .filter(|c| c.is_ascii_alphanumeric() || *c == b'+' || *c == b'/')
+        .map(value)
+        .collect();
+    let mut out = Vec::with_capacity(digits.len() * 3 / 4);
+    for chunk in digits.chunks(4) {
+        let n = chunk
+            .iter()
+            .enumerate()
+            .fold(0u32, |n, (i, &d)| n | (d as u32) << (18 - 6 * i));
+        out.extend_from_slice(&n.to_be_bytes()[1..chunk.len()]);
+    }
+    out
+}
+
+/// As a user does: the page loads, the image appears, a click at the middle of the image
+/// (the glass sphere of the built-in scene) brings its ray tree: a camera ray hitting the
+/// glass with reflected and refracted children, its rays over the image and in the 3-D
+/// view; then the `show` control's cost view. A screenshot is kept.
+#[test]
+fn a_click_on_the_glass_sphere_shows_its_ray_tree() {
+    let required = std::env::var("PLENUM_REQUIRE_BROWSER").as_deref() == Ok("1");
+    let driver_there = Command::new("chromedriver")
+        .arg("--version")
+        .stdout(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    let Some(browser) = chromium().filter(|_| driver_there) else {
+        assert!(
+            !required,
+            "PLENUM_REQUIRE_BROWSER=1 but Chromium or ChromeDriver is not installed"
+        );
+        eprintln!("skipped: no Chromium and ChromeDriver (Debian: apt-get install chromium chromium-driver)");
+        return;
+    };
+    let (_view, base) = start_view(&["--width", "64", "--height", "48", "--spp", "4"]);
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let _driver = Killed(
+        Command::new("chromedriver")
+            .arg(format!("--port={port}"))
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    );
+    let started = Instant::now();
+    while TcpStream::connect(("127.0.0.1", port)).is_err() {
+        assert!(
+            started.elapsed() < Duration::from_secs(30),
+            "ChromeDriver did not start"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let path = Command::new("sh")
+        .args(["-c", &format!("command -v {browser}")])
+        .output()
+        .unwrap();
+    let binary = String::from_utf8_lossy(&path.stdout).trim().to_string();
+    let session = webdriver(
+        port,
+        "POST",
+        "/session",
+        Some(
+            json!({"capabilities": {"alwaysMatch": {"goog:chromeOptions": {
+                "binary": binary,
+                "args": ["--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                         "--window-size=1280,800"],
+            }}}}),
+        ),
+    );
+    let id = session["sessionId"]
+        .as_str()
+        .unwrap_or_else(|| panic!("no session: {session}"))
+        .to_string();
+    let at = |p: &str| format!("/session/{id}{p}");
+    let script = |code: &str| {
+        webdriver(
+            port,
+            "POST",
+            &at("/execute/sync"),
+            Some(json!({"script": code, "args": []})),
+        )
+    };
+    let wait = |code: &str, what: &str| {
+        let started = Instant::now();
+        loop {
+            let v = script(code);
+            if !v.is_null() && v != json!(false) {
+                return v;
+            }
+            assert!(started.elapsed() < Duration::from_secs(60), "never {what}");
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    };
+    webdriver(port, "POST", &at("/url"), Some(json!({ "url": base })));
+    wait(
+        "return document.body.dataset.imageVersion || null",
+        "an image",
+    );
+    let element = webdriver(
+        port,
+        "POST",
+        &at("/element"),
+        Some(json!({"using": "css selector", "value": "#viewport"})),
+    );
+    let element = element
+        .as_object()
+        .and_then(|o| o.values().next())
+        .and_then(Value::as_str)
+        .unwrap()
+        .to_string();
+    // The image is fitted and centred in the viewport: its middle is the glass sphere's.
+    webdriver(
+        port,
+        "POST",
+        &at(&format!("/element/{element}/click")),
+        Some(json!({})),
+    );
+    let pixel = wait(
+        "return document.getElementById('tree').dataset.pixel || null",
+        "a ray tree",
+    );
+    let (x, y) = pixel.as_str().unwrap().split_once(',').unwrap();
+    let (x, y): (i32, i32) = (x.parse().unwrap(), y.parse().unwrap());
+    assert!(
+        (x - 32).abs() <= 2 && (y - 24).abs() <= 2,
+        "clicked pixel ({x}, {y})"
+    );
+    let tree = script("return document.getElementById('tree').innerHTML").to_string();
+    assert!(
+        tree.contains(">camera<") && tree.contains("glass sphere"),
+        "{tree}"
+    );
+    assert!(
+        tree.contains(">reflected<") && tree.contains(">refracted<"),
+        "{tree}"
+    );
+    let overlay = script("return document.querySelectorAll('#rays line').length");
+    assert!(overlay.as_u64() >= Some(3), "{overlay}");
+    let segments = script("return +document.getElementById('space').dataset.segments");
+    assert!(segments.as_u64() >= Some(3), "3-D view: {segments}");
+    let shot = webdriver(port, "GET", &at("/screenshot"), None);
+    let png = base64_decode(shot.as_str().unwrap());
+    assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000);
+    let file = std::env::temp_dir().join(format!("plenum-view-click-{}.png", std::process::id()));
+    std::fs::write(&file, &png).unwrap();
+    eprintln!("screenshot: {}", file.display());
+    // The cost view, by the control.
+    script("const s = document.getElementById('show'); s.value = 'cost'; s.dispatchEvent(new Event('change'));");
+    wait(
+        "return document.body.dataset.shown === 'cost'",
+        "the cost view",
+    );
+    webdriver(port, "DELETE", &at(""), None);
 }
