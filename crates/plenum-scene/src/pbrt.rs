@@ -62,6 +62,7 @@ pub fn parse(path: &Path, text: String) -> Result<(SceneBuilder, RenderDefaults,
         objects: HashMap::new(),
         recording: None,
         camera: None,
+        transform_times: (0.0, 1.0),
         film_size: None,
         default_material: None,
         count: 0,
@@ -128,10 +129,24 @@ impl Params {
 /// pbrt's graphics state: what `AttributeBegin` saves and `AttributeEnd` restores.
 #[derive(Clone, Default)]
 struct State {
+    /// The current transformation at the shutter-open time (`TransformTimes`' start).
     ctm: Option<Matrix4>,
+    /// At the end time, where it differs (motion blur); else as `ctm`.
+    ctm_end: Option<Matrix4>,
+    /// Which of the two the transformation directives change (`ActiveTransform`).
+    active: Active,
     material: Option<MaterialId>,
     area_light: Option<AreaLight>,
     reverse_orientation: bool,
+}
+
+/// `ActiveTransform`'s choice.
+#[derive(Clone, Copy, Default, PartialEq, Eq)]
+enum Active {
+    #[default]
+    All,
+    Start,
+    End,
 }
 
 #[derive(Clone)]
@@ -147,6 +162,8 @@ struct Recorded {
     name: String,
     shape: Shape,
     to_world: Matrix4,
+    /// At the end time.
+    to_world_end: Matrix4,
     material: MaterialId,
 }
 
@@ -161,11 +178,15 @@ struct Parser {
     /// Textures by name: spectrum and float textures share a namespace here, as a texture
     /// parameter names one of either kind.
     textures: HashMap<String, Texture>,
-    coordinate_systems: HashMap<String, Matrix4>,
+    /// Named coordinate systems: the transformations at the start and end times.
+    coordinate_systems: HashMap<String, [Matrix4; 2]>,
     objects: HashMap<String, Vec<Recorded>>,
     recording: Option<(String, Vec<Recorded>)>,
-    /// The camera statement: its camera-from-world matrix, parameters and where.
-    camera: Option<(Matrix4, Params, String, Loc)>,
+    /// The camera statement: its camera-from-world matrices (start and end time),
+    /// parameters and where.
+    camera: Option<([Matrix4; 2], Params, String, Loc)>,
+    /// `TransformTimes`: the times of the start and end transformations.
+    transform_times: (f64, f64),
     film_size: Option<(u32, u32)>,
     default_material: Option<MaterialId>,
     count: usize,
@@ -177,6 +198,25 @@ struct Parser {
 impl Parser {
     fn ctm(&self) -> Matrix4 {
         self.state.ctm.unwrap_or(Matrix4::IDENTITY)
+    }
+
+    /// The current transformation at the end time.
+    fn ctm_end(&self) -> Matrix4 {
+        self.state.ctm_end.unwrap_or(self.ctm())
+    }
+
+    /// Applies `f` to the current transformations `ActiveTransform` chose.
+    fn set_ctm(&mut self, f: impl Fn(&Matrix4) -> Matrix4) {
+        let (start, end) = (self.ctm(), self.ctm_end());
+        // Both kept: an end left as it was must not follow a changed start.
+        if self.state.active != Active::End {
+            self.state.ctm = Some(f(&start));
+        }
+        self.state.ctm_end = Some(if self.state.active != Active::Start {
+            f(&end)
+        } else {
+            end
+        });
     }
 
     fn error(&self, loc: &Loc, message: impl Into<String>) -> SceneError {
@@ -747,31 +787,33 @@ impl Parser {
                 .ok_or_else(|| self.error(loc, format!("{d} needs {what}")))
         };
         let ctm = self.ctm();
-        let then = |t: Option<Transform>| -> Result<Matrix4> {
-            t.map(|t| ctm.mul(&t.matrix))
+        // A directive's own transformation, multiplied onto the current ones on the right.
+        let checked = |t: Option<Transform>| -> Result<Matrix4> {
+            t.map(|t| t.matrix)
                 .ok_or_else(|| self.error(loc, format!("a singular {d}")))
         };
         let mut name_of_type = String::new();
         match d {
-            "Identity" => self.state.ctm = Some(Matrix4::IDENTITY),
+            "Identity" => self.set_ctm(|_| Matrix4::IDENTITY),
             "Translate" => {
                 need_nums(3)?;
-                self.state.ctm = Some(then(Some(Transform::translate(Vec3::new(
+                let t = checked(Some(Transform::translate(Vec3::new(
                     nums[0], nums[1], nums[2],
-                ))))?);
+                ))))?;
+                self.set_ctm(|c| c.mul(&t));
             }
             "Scale" => {
                 need_nums(3)?;
-                self.state.ctm = Some(then(Transform::scale(Vec3::new(
-                    nums[0], nums[1], nums[2],
-                )))?);
+                let t = checked(Transform::scale(Vec3::new(nums[0], nums[1], nums[2])))?;
+                self.set_ctm(|c| c.mul(&t));
             }
             "Rotate" => {
                 need_nums(4)?;
-                self.state.ctm = Some(then(Transform::rotate(
+                let t = checked(Transform::rotate(
                     Vec3::new(nums[1], nums[2], nums[3]),
                     nums[0],
-                ))?);
+                ))?;
+                self.set_ctm(|c| c.mul(&t));
             }
             "LookAt" => {
                 need_nums(9)?;
@@ -789,7 +831,8 @@ impl Parser {
                     ));
                 }
                 let world_from_camera = Transform::frame(eye, right, new_up, dir);
-                self.state.ctm = Some(then(world_from_camera.map(|t| t.inverted()))?);
+                let t = checked(world_from_camera.map(|t| t.inverted()))?;
+                self.set_ctm(|c| c.mul(&t));
             }
             "Transform" | "ConcatTransform" => {
                 need_nums(16)?;
@@ -799,16 +842,24 @@ impl Parser {
                         self.error(loc, format!("{d}: the matrix is singular, or not affine"))
                     );
                 }
-                self.state.ctm = Some(if d == "Transform" { m } else { ctm.mul(&m) });
+                if d == "Transform" {
+                    self.set_ctm(|_| m);
+                } else {
+                    self.set_ctm(|c| c.mul(&m));
+                }
             }
             "CoordinateSystem" => {
                 let name = need_str("a name")?;
-                self.coordinate_systems.insert(name, ctm);
+                let both = [ctm, self.ctm_end()];
+                self.coordinate_systems.insert(name, both);
             }
             "CoordSysTransform" => {
                 let name = need_str("a name")?;
-                match self.coordinate_systems.get(&name) {
-                    Some(m) => self.state.ctm = Some(*m),
+                match self.coordinate_systems.get(&name).copied() {
+                    Some([start, end]) => {
+                        self.state.ctm = Some(start);
+                        self.state.ctm_end = Some(end);
+                    }
                     None => self.warn(
                         loc,
                         format!(
@@ -817,8 +868,41 @@ impl Parser {
                     ),
                 }
             }
-            "TransformTimes" | "ActiveTransform" => {
-                self.warn(loc, format!("{d}: motion blur is not supported: the shutter-open transformation is used"));
+            "ActiveTransform" => {
+                // A bare word (or, leniently, a quoted one).
+                let word = args.iter().find_map(|(t, _)| match t {
+                    Tok::Word(w) | Tok::Str(w) => Some(w.clone()),
+                    _ => None,
+                });
+                let Some(word) = word else {
+                    return Err(self.error(loc, "ActiveTransform needs StartTime, EndTime or All"));
+                };
+                self.state.active = match word.as_str() {
+                    "StartTime" => Active::Start,
+                    "EndTime" => Active::End,
+                    "All" => Active::All,
+                    other => {
+                        return Err(self.unknown(
+                            loc,
+                            "ActiveTransform",
+                            other,
+                            &["StartTime", "EndTime", "All"],
+                        ))
+                    }
+                };
+            }
+            "TransformTimes" => {
+                need_nums(2)?;
+                if !(nums[0].is_finite() && nums[1].is_finite() && nums[1] > nums[0]) {
+                    return Err(self.error(
+                        loc,
+                        format!(
+                            "TransformTimes: expected an end time after the start, not {} and {}",
+                            nums[0], nums[1]
+                        ),
+                    ));
+                }
+                self.transform_times = (nums[0], nums[1]);
             }
             "ReverseOrientation" => {
                 self.state.reverse_orientation = !self.state.reverse_orientation
@@ -839,6 +923,7 @@ impl Parser {
                 Some((state, _)) => {
                     if d == "TransformEnd" {
                         self.state.ctm = state.ctm;
+                        self.state.ctm_end = state.ctm_end;
                     } else {
                         self.state = state;
                     }
@@ -847,8 +932,9 @@ impl Parser {
             },
             "WorldBegin" => {
                 self.state.ctm = Some(Matrix4::IDENTITY);
+                self.state.ctm_end = None;
                 self.coordinate_systems
-                    .insert("world".into(), Matrix4::IDENTITY);
+                    .insert("world".into(), [Matrix4::IDENTITY; 2]);
             }
             "WorldEnd" => self.warn(loc, "WorldEnd is pbrt-v3's: ignored"),
             "Option" | "Attribute" | "MakeNamedMedium" | "MediumInterface" => {
@@ -867,15 +953,19 @@ impl Parser {
             "Accelerator" => params.list.iter().for_each(|p| p.used.set(true)),
             "Camera" => {
                 name_of_type = need_str("a type")?;
-                let world_from_camera = Transform::from_matrix(ctm)
-                    .ok_or_else(|| self.error(loc, "the camera's transformation is singular"))?
-                    .inverted()
-                    .matrix;
+                let both = [ctm, self.ctm_end()];
+                let mut world_from_camera = [Matrix4::IDENTITY; 2];
+                for (w, m) in world_from_camera.iter_mut().zip(both) {
+                    *w = Transform::from_matrix(m)
+                        .ok_or_else(|| self.error(loc, "the camera's transformation is singular"))?
+                        .inverted()
+                        .matrix;
+                }
                 self.coordinate_systems
                     .insert("camera".into(), world_from_camera);
                 // Read at the end, when the film's size is known; its parameters are
                 // reported then.
-                self.camera = Some((ctm, params, name_of_type, loc.clone()));
+                self.camera = Some((both, params, name_of_type, loc.clone()));
                 return Ok(());
             }
             "Film" => {
@@ -1003,12 +1093,17 @@ impl Parser {
                         },
                     );
                 };
+                let ctm_end = self.ctm_end();
                 for r in shapes {
-                    let m = ctm.mul(&r.to_world);
-                    let t = Transform::from_matrix(m)
-                        .ok_or_else(|| self.error(loc, "a singular instance transformation"))?;
+                    let singular = || self.error(loc, "a singular instance transformation");
+                    let t = Transform::from_matrix(ctm.mul(&r.to_world)).ok_or_else(singular)?;
+                    let t_end = Transform::from_matrix(ctm_end.mul(&r.to_world_end))
+                        .ok_or_else(singular)?;
                     self.builder
                         .add_object(format!("{name}/{}", r.name), r.shape, t, r.material);
+                    if t_end != t {
+                        self.builder.set_last_motion(t_end);
+                    }
                 }
             }
             "Include" | "Import" => {
@@ -1613,6 +1708,12 @@ impl Parser {
     fn light(&mut self, ty: &str, p: &Params, loc: &Loc) -> Result<()> {
         let t = Transform::from_matrix(self.ctm())
             .ok_or_else(|| self.error(loc, "the light's transformation is singular"))?;
+        if self.ctm_end() != self.ctm() {
+            self.warn(
+                loc,
+                "a moving light is not supported (nor in pbrt-v4): its start-time transformation is used",
+            );
+        }
         self.count += 1;
         let name = format!("{ty} light {}", self.count);
         let power = |s: &Self, k_e: f64| -> Result<f64> {
@@ -1964,8 +2065,12 @@ impl Parser {
             }
         }
         let m = self.ctm().mul(&frame.matrix);
+        let m_end = self.ctm_end().mul(&frame.matrix);
         let to_world = Transform::from_matrix(m)
             .ok_or_else(|| self.error(loc, "the shape's transformation is singular"))?;
+        let to_world_end = Transform::from_matrix(m_end)
+            .ok_or_else(|| self.error(loc, "the shape's end-time transformation is singular"))?;
+        let moves = m_end != m;
         let material = self.material_now();
         self.count += 1;
         let name = format!("{ty} {}", self.count);
@@ -1974,6 +2079,7 @@ impl Parser {
                 name,
                 shape,
                 to_world: m,
+                to_world_end: m_end,
                 material,
             });
             if area.is_some() {
@@ -2002,8 +2108,16 @@ impl Parser {
                 } else if let Some((s, k)) = a.spectrum {
                     self.builder.set_last_light_spectrum(s, k);
                 }
+                if moves {
+                    self.warn(loc, "a moving area light is not supported: it stays at its start-time transformation");
+                }
             }
-            None => self.builder.add_object(name, shape, to_world, material),
+            None => {
+                self.builder.add_object(name, shape, to_world, material);
+                if moves {
+                    self.builder.set_last_motion(to_world_end);
+                }
+            }
         }
         Ok(())
     }
@@ -2014,7 +2128,7 @@ impl Parser {
         let (m, params, ty, loc) = match self.camera.take() {
             Some(c) => c,
             None => (
-                Matrix4::IDENTITY,
+                [Matrix4::IDENTITY; 2],
                 Params { list: Vec::new() },
                 "perspective".to_string(),
                 Loc {
@@ -2024,12 +2138,24 @@ impl Parser {
             ),
         };
         let (w, h) = (self.defaults.width as f64, self.defaults.height as f64);
-        let world_from_camera = Transform::from_matrix(m)
-            .map(|t| t.inverted())
-            .unwrap_or(Transform::IDENTITY);
-        let position = world_from_camera.point(Vec3::ZERO);
-        let forward = world_from_camera.vector(Vec3::Z).normalized();
-        let up = world_from_camera.vector(Vec3::Y).normalized();
+        // Where the camera is, looks and has its up at the start and end times.
+        let frame = |m: Matrix4| {
+            let world_from_camera = Transform::from_matrix(m)
+                .map(|t| t.inverted())
+                .unwrap_or(Transform::IDENTITY);
+            (
+                world_from_camera,
+                world_from_camera.point(Vec3::ZERO),
+                world_from_camera.vector(Vec3::Z).normalized(),
+                world_from_camera.vector(Vec3::Y).normalized(),
+            )
+        };
+        let (world_from_camera, position, forward, up) = frame(m[0]);
+        let (_, position_end, forward_end, up_end) = frame(m[1]);
+        let motion = (m[1] != m[0]).then_some((position_end, position_end + forward_end));
+        if motion.is_some() && up_end.dot(up) < 1.0 - 1e-9 {
+            self.warn(&loc, "the camera's turn about its view while the shutter is open is not supported: it keeps its start-time up");
+        }
         // pbrt's image x runs along camera +x; Plenum's along forward × up unless told.
         let left_handed = world_from_camera.vector(Vec3::X).dot(forward.cross(up)) < 0.0;
         if ty != "perspective" {
@@ -2062,8 +2188,20 @@ impl Parser {
                 );
             }
         }
-        params.get("shutteropen");
-        params.get("shutterclose");
+        // The shutter in the times of the two transformations, which Plenum's motion puts at
+        // 0 and 1 (before and after them, things stay where they are, as in pbrt).
+        let (t0, t1) = self.transform_times;
+        let open = self.float(&params, "shutteropen", 0.0).unwrap_or(0.0);
+        let close = self.float(&params, "shutterclose", 1.0).unwrap_or(1.0);
+        let shutter = if close >= open {
+            [(open - t0) / (t1 - t0), (close - t0) / (t1 - t0)]
+        } else {
+            self.warn(
+                &loc,
+                "the shutter closes before it opens: it opens at 0 and closes at 1",
+            );
+            [(0.0 - t0) / (t1 - t0), (1.0 - t0) / (t1 - t0)]
+        };
         self.report_unused("Camera", &ty, &params);
         self.builder.camera = CameraSettings {
             position,
@@ -2076,6 +2214,8 @@ impl Parser {
                 ..Lens::default()
             },
             left_handed,
+            shutter,
+            motion,
             ..CameraSettings::default()
         };
     }
