@@ -104,6 +104,7 @@ enum Tok {
 }
 
 /// A parameter: `"type name" values`.
+#[derive(Clone)]
 struct Param {
     ty: String,
     name: String,
@@ -112,6 +113,9 @@ struct Param {
     bools: Vec<bool>,
     loc: Loc,
     used: Cell<bool>,
+    /// Given by an `Attribute` directive, not the statement: a default that statements
+    /// which have no use for it pass over without a warning.
+    inherited: bool,
 }
 
 struct Params {
@@ -126,6 +130,9 @@ impl Params {
     }
 }
 
+/// The kinds of statement `Attribute` gives defaults for.
+const ATTRIBUTE_KINDS: [&str; 5] = ["shape", "light", "material", "medium", "texture"];
+
 /// pbrt's graphics state: what `AttributeBegin` saves and `AttributeEnd` restores.
 #[derive(Clone, Default)]
 struct State {
@@ -135,6 +142,9 @@ struct State {
     ctm_end: Option<Matrix4>,
     /// Which of the two the transformation directives change (`ActiveTransform`).
     active: Active,
+    /// `Attribute` defaults by the kind of statement they are for (`shape`, `light`,
+    /// `material`, `medium`, `texture`), in the order given.
+    attributes: HashMap<String, Vec<Param>>,
     material: Option<MaterialId>,
     area_light: Option<AreaLight>,
     reverse_orientation: bool,
@@ -458,6 +468,7 @@ impl Parser {
                 bools,
                 loc: loc.clone(),
                 used: Cell::new(false),
+                inherited: false,
             });
         }
         Ok(Params { list })
@@ -761,6 +772,21 @@ impl Parser {
     // ---- Statements ----
 
     fn statement(&mut self, d: &str, loc: &Loc, args: &[(Tok, Loc)], params: Params) -> Result<()> {
+        // `Attribute` defaults come first: the statement's own parameters, found later, win.
+        let kind = match d {
+            "Shape" => Some("shape"),
+            "LightSource" | "AreaLightSource" => Some("light"),
+            "Material" | "MakeNamedMaterial" => Some("material"),
+            "Texture" => Some("texture"),
+            "MakeNamedMedium" => Some("medium"),
+            _ => None,
+        };
+        let params = match kind.and_then(|k| self.state.attributes.get(k)) {
+            Some(given) => Params {
+                list: given.iter().cloned().chain(params.list).collect(),
+            },
+            None => params,
+        };
         let nums: Vec<f64> = args
             .iter()
             .filter_map(|(t, _)| if let Tok::Num(x) = t { Some(*x) } else { None })
@@ -937,7 +963,22 @@ impl Parser {
                     .insert("world".into(), [Matrix4::IDENTITY; 2]);
             }
             "WorldEnd" => self.warn(loc, "WorldEnd is pbrt-v3's: ignored"),
-            "Option" | "Attribute" | "MakeNamedMedium" | "MediumInterface" => {
+            "Attribute" => {
+                let kind = need_str("shape, light, material, medium or texture")?;
+                if !ATTRIBUTE_KINDS.contains(&kind.as_str()) {
+                    return Err(self.unknown(loc, "Attribute kind", &kind, &ATTRIBUTE_KINDS));
+                }
+                let given = self.state.attributes.entry(kind).or_default();
+                for q in &params.list {
+                    q.used.set(true);
+                    given.push(Param {
+                        used: Cell::new(false),
+                        inherited: true,
+                        ..q.clone()
+                    });
+                }
+            }
+            "Option" | "MakeNamedMedium" | "MediumInterface" => {
                 self.warn(loc, format!("{d} is not supported: ignored"));
                 params.list.iter().for_each(|p| p.used.set(true));
             }
@@ -1184,7 +1225,7 @@ impl Parser {
 
     fn report_unused(&mut self, d: &str, ty: &str, params: &Params) {
         for q in &params.list {
-            if !q.used.get() {
+            if !q.used.get() && !q.inherited {
                 let what = if ty.is_empty() {
                     d.to_string()
                 } else {

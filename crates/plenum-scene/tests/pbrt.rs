@@ -507,3 +507,57 @@ LightSource "point" "rgb I" [ 1 1 1 ]
     let e = error("TransformTimes 1 0\nWorldBegin\n").to_string();
     assert!(e.contains("expected an end time after the start"), "{e}");
 }
+
+/// `Attribute` gives defaults to the statements of its kind that follow in the graphics
+/// state: a sphere's radius, a light's scale, a material's reflectance; the statement's own
+/// parameter wins, `AttributeEnd` forgets them, a default a statement has no use for is
+/// passed over silently, and an unknown kind is a located error.
+#[test]
+fn attributes_give_defaults_to_the_statements_of_their_kind() {
+    let l = load(
+        r#"WorldBegin
+AttributeBegin
+  Attribute "shape" "float radius" 2 "float innerradius" 0
+  Attribute "light" "float scale" 3
+  Attribute "material" "rgb reflectance" [ 0.2 0.4 0.6 ]
+  Material "diffuse"
+  Shape "sphere"
+  Shape "sphere" "float radius" 0.5
+  LightSource "point" "rgb I" [ 1 1 1 ]
+AttributeEnd
+Shape "sphere"
+"#,
+    );
+    let radius = |i: usize| match &l.scene.geometry.primitives[i].shape {
+        plenum_core::geometry::Shape::Sphere(s) => s.radius,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!([radius(0), radius(1), radius(2)], [2.0, 0.5, 1.0]);
+    let t = native(&l);
+    let light = &t["lights"].as_array().unwrap()[0];
+    let intensity = light.get("intensity").map_or(1.0, number);
+    let color: Vec<f64> = light["color"]
+        .as_array()
+        .map_or(vec![1.0; 3], |c| c.iter().map(number).collect());
+    assert!(
+        color.iter().all(|c| (c * intensity - 3.0).abs() < 1e-9),
+        "{light:?}"
+    );
+    let materials = t["materials"].as_table().unwrap();
+    assert!(
+        materials
+            .values()
+            .any(|m| format!("{m:?}").contains("0.2") && format!("{m:?}").contains("0.6")),
+        "{materials:?}"
+    );
+    assert!(
+        !l.warnings.iter().any(|w| w.contains("innerradius")),
+        "{:?}",
+        l.warnings
+    );
+    let e = error("WorldBegin\nAttribute \"shapes\" \"float radius\" 2\n").to_string();
+    assert!(
+        e.contains("scene.pbrt:2:1") && e.contains("unknown Attribute kind `shapes`"),
+        "{e}"
+    );
+}
