@@ -81,17 +81,7 @@ fn the_page_shows_the_image_and_a_pixels_ray_tree() {
         eprintln!("skipped: no Chromium (Debian: apt-get install chromium)");
         return;
     };
-    let mut view = Command::new(env!("CARGO_BIN_EXE_plenum"))
-        .args(["view", "--width", "64", "--height", "48", "--spp", "4"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(view.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let base = line.split_whitespace().last().unwrap().to_string();
+    let (view, base) = start_view(&["--width", "64", "--height", "48", "--spp", "4"]);
     // The glass sphere of the built-in scene is in the middle of the image.
     let url = format!("{base}#trace=32,24");
 
@@ -142,8 +132,7 @@ fn the_page_shows_the_image_and_a_pixels_ray_tree() {
         dom.contains("node visits + primitive tests per pixel"),
         "{dom}"
     );
-    let _ = view.kill();
-    let _ = view.wait();
+    drop(view);
     let png = std::fs::read(&shot).expect("Chromium wrote no screenshot");
     assert!(png.starts_with(b"\x89PNG") && png.len() > 10_000);
     eprintln!("screenshot: {}", shot.display());

@@ -273,9 +273,8 @@ impl RayCounts {
     /// Runs `work` on this thread, adding the acceleration structures' cost it spends to
     /// `cost` (work that calls into the thread pool would be charged what it steals).
     pub fn charging<R>(&mut self, work: impl FnOnce(&mut RayCounts) -> R) -> R {
-        let before = cost::so_far();
-        let r = work(self);
-        self.cost += cost::so_far() - before;
+        let (r, spent) = cost::spent(|| work(self));
+        self.cost += spent;
         r
     }
 
