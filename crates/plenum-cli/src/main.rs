@@ -658,6 +658,11 @@ fn render_settings(view: &ViewArgs, loaded: &mut LoadedScene) -> Result<RenderSe
         .map(|a| a.0)
         .or(d.integrator)
         .unwrap_or_else(|| IntegratorKind::default_for(&loaded.scene));
+    if loaded.scene.camera.orthographic.is_some()
+        && matches!(method, IntegratorKind::Light | IntegratorKind::Bdpt)
+    {
+        return Err(format!("integrator `{}` cannot render through an orthographic camera: its rays' one direction is a delta that no light path meets (as in pbrt-v4); use path, photon or sppm", method.name()));
+    }
     let ignored = options_ignored_by(view, method);
     if !ignored.is_empty() {
         eprintln!(

@@ -1880,3 +1880,40 @@ fn the_tutorials_script_makes_every_picture_it_shows() {
         );
     }
 }
+
+/// Through an orthographic camera the methods that start at the camera render; light
+/// tracing and BDPT, whose light paths cannot meet its one direction, are refused, exit 2.
+#[test]
+fn an_orthographic_camera_is_refused_by_light_tracing_and_bdpt() {
+    let tmp = temp_dir("ortho");
+    let dir = tmp.path();
+    std::fs::write(
+        dir.join("ortho.toml"),
+        "[camera]\nposition = [0, 1, 5]\nlook_at = [0, 0, 0]\northographic = 3\nresolution = [16, 12]\n\
+         [[lights]]\ntype = \"point\"\nposition = [2, 4, 3]\n\
+         [materials.white]\ntype = \"diffuse\"\nreflectance = [0.8, 0.8, 0.8]\n\
+         [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"white\"\n",
+    )
+    .unwrap();
+    let args: Vec<String> = ["ortho.toml", "--spp", "1", "--quiet"]
+        .map(String::from)
+        .to_vec();
+    for method in ["path", "whitted", "photon"] {
+        let o = plenum()
+            .current_dir(dir)
+            .arg("render")
+            .args(&args)
+            .args(["--integrator", method, "-o", "o.pfm"])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{method}: {}", stderr(&o));
+    }
+    for method in ["light", "bdpt"] {
+        assert_refused(
+            dir,
+            &args,
+            &["--integrator", method, "-o", "o.pfm"],
+            "cannot render through an orthographic camera",
+        );
+    }
+}

@@ -1,5 +1,6 @@
 //! The camera: a pinhole, or a thin lens with an aperture and a focus distance (depth of
-//! field), optionally moving while its shutter is open (motion blur).
+//! field), optionally moving while its shutter is open (motion blur); or an orthographic
+//! (parallel) projection, whose rays all run along the view direction.
 //!
 //! Times: objects and the camera are posed at time 0 (shutter open) and time 1 (shutter
 //! close) and move in between; each ray's time is drawn uniformly from the shutter interval.
@@ -49,6 +50,12 @@ pub struct CameraSettings {
     /// The image's x axis is up × view instead of view × up: the mirror image, as pbrt's
     /// left-handed camera space sees a scene (and Mitsuba's through a mirroring transform).
     pub left_handed: bool,
+    /// A parallel projection instead of the perspective one: the height of the view in
+    /// scene units (`fov_degrees` and the lens are then unused). The rays start on the
+    /// plane through `position` across the view and run along it. No light path can reach
+    /// such a camera (its direction is a delta, as in pbrt-v4): light tracing and BDPT
+    /// refuse it.
+    pub orthographic: Option<f64>,
 }
 
 impl Default for CameraSettings {
@@ -62,6 +69,7 @@ impl Default for CameraSettings {
             shutter: [0.0, 1.0],
             motion: None,
             left_handed: false,
+            orthographic: None,
         }
     }
 }
@@ -125,7 +133,11 @@ pub struct Camera {
 
 impl Camera {
     pub fn new(s: &CameraSettings, width: u32, height: u32) -> Camera {
-        let half_height = (s.fov_degrees.to_radians() * 0.5).tan();
+        // Perspective: the image plane at distance 1; orthographic: the view itself.
+        let half_height = match s.orthographic {
+            Some(h) => 0.5 * h,
+            None => (s.fov_degrees.to_radians() * 0.5).tan(),
+        };
         Camera {
             settings: *s,
             frame: Frame::new(s.position, s.look_at, s.up, s.left_handed),
@@ -148,8 +160,23 @@ impl Camera {
     /// top-left corner of the image and (width, height) the bottom-right; pixel (i, j) covers
     /// [i, i+1) × [j, j+1).
     pub fn ray(&self, x: f64, y: f64) -> Ray {
+        if self.is_orthographic() {
+            return Ray::new(self.origin(&self.frame, x, y), self.frame.forward);
+        }
         let d = self.direction(&self.frame, x, y);
         Ray::new(self.frame.position, d.normalized())
+    }
+
+    /// Whether the projection is parallel.
+    pub fn is_orthographic(&self) -> bool {
+        self.settings.orthographic.is_some()
+    }
+
+    /// Orthographic: where the ray through raster (x, y) starts.
+    fn origin(&self, f: &Frame, x: f64, y: f64) -> Vec3 {
+        f.position
+            + f.right * (x * self.pixel_size - self.half_width)
+            + f.up * (self.half_height - y * self.pixel_size)
     }
 
     /// The ray through raster position (x, y) from the lens point `lens` ∈ [0, 1)² at the
@@ -157,6 +184,9 @@ impl Camera {
     pub fn sample_ray(&self, x: f64, y: f64, lens: [f64; 2], shutter: f64) -> Ray {
         let time = self.time(shutter);
         let frame = self.frame_at(time);
+        if self.is_orthographic() {
+            return Ray::new(self.origin(&frame, x, y), frame.forward).at_time(time);
+        }
         let d = self.direction(&frame, x, y);
         let l = &self.settings.lens;
         if l.radius <= 0.0 {
@@ -219,9 +249,10 @@ impl Camera {
         }
     }
 
-    /// The camera is a pinhole: its position is a delta that no path can hit.
+    /// The camera is a pinhole: its position is a delta that no path can hit. (An
+    /// orthographic camera's direction is one: see [`Camera::we`].)
     pub fn is_pinhole(&self) -> bool {
-        self.settings.lens.radius <= 0.0
+        self.settings.lens.radius <= 0.0 || self.is_orthographic()
     }
 
     /// Importance W_e of a ray leaving the lens (at its time), and the raster point it
@@ -229,7 +260,12 @@ impl Camera {
     /// image plane's area at distance 1, so that ∫ W_e cos θ dω dA_lens = 1 over the image
     /// (pbrt-v4's `PerspectiveCamera::We`). A pixel is the sum of the splats in it over
     /// the number of light paths per pixel.
+    /// An orthographic camera has none: its rays' direction is a delta that no light path
+    /// meets.
     pub fn we(&self, ray: &Ray) -> Option<(f64, [f64; 2])> {
+        if self.is_orthographic() {
+            return None;
+        }
         let frame = self.frame_at(ray.time);
         let w = ray.direction.normalized();
         let cos = w.dot(frame.forward);
@@ -247,6 +283,9 @@ impl Camera {
     /// The densities of a camera ray: its lens point per unit area and its direction per
     /// steradian (pbrt-v4's `PDF_We`); zeros outside the image.
     pub fn pdf_we(&self, ray: &Ray) -> (f64, f64) {
+        if self.is_orthographic() {
+            return (0.0, 0.0);
+        }
         let frame = self.frame_at(ray.time);
         let w = ray.direction.normalized();
         let cos = w.dot(frame.forward);
@@ -262,6 +301,9 @@ impl Camera {
     /// A lens point seen from `p` at `time`, for connecting a light path to the camera
     /// (pbrt-v4's `SampleWi`): `None` if the point is behind the camera or outside the image.
     pub fn sample_wi(&self, p: Vec3, lens: [f64; 2], time: f64) -> Option<CameraSample> {
+        if self.is_orthographic() {
+            return None;
+        }
         let frame = self.frame_at(time);
         let q = self.lens_point(&frame, lens);
         let to = q - p;
@@ -327,6 +369,16 @@ impl Camera {
     /// image.
     pub fn project_segment(&self, a: Vec3, b: Vec3) -> Option<([f64; 2], [f64; 2])> {
         let frame = self.frame_at(0.0);
+        if self.is_orthographic() {
+            let raster = |p: Vec3| {
+                let d = p - frame.position;
+                [
+                    (d.dot(frame.right) + self.half_width) / self.pixel_size,
+                    (self.half_height - d.dot(frame.up)) / self.pixel_size,
+                ]
+            };
+            return Some((raster(a), raster(b)));
+        }
         let depth = |p: Vec3| (p - frame.position).dot(frame.forward);
         let (za, zb) = (depth(a), depth(b));
         // Points this close to the lens's plane would project to no sensible place.
@@ -354,6 +406,9 @@ impl Camera {
 
     /// Size of one pixel on a plane facing the camera at distance `depth`, in scene units.
     pub fn pixel_footprint(&self, depth: f64) -> f64 {
+        if self.is_orthographic() {
+            return self.pixel_size;
+        }
         self.pixel_size * depth
     }
 }

@@ -749,16 +749,29 @@ impl<'a> Reader<'a> {
                         }
                         (p.yfov() as f64).to_degrees().clamp(0.01, 179.0)
                     }
-                    gltf::camera::Projection::Orthographic(_) => {
-                        self.warn(format!("cameras[{}]: orthographic cameras are not supported: a perspective one of 40° from the same place", camera.index()));
-                        40.0
+                    gltf::camera::Projection::Orthographic(_) => 40.0,
+                };
+                // An orthographic camera's view is 2·xmag by 2·ymag, its image as wide.
+                let orthographic = match camera.projection() {
+                    gltf::camera::Projection::Orthographic(o) => {
+                        let (x, y) = (o.xmag().abs() as f64, o.ymag().abs() as f64);
+                        if y > 0.0 && x > 0.0 {
+                            defaults.height = 480;
+                            defaults.width = ((480.0 * x / y).round() as u32).clamp(1, 1 << 16);
+                            Some(2.0 * y)
+                        } else {
+                            self.warn(format!("cameras[{}]: an orthographic camera of zero size: a perspective one of 40° from the same place", camera.index()));
+                            None
+                        }
                     }
+                    _ => None,
                 };
                 self.builder.camera = CameraSettings {
                     position,
                     look_at: position + forward,
                     up,
                     fov_degrees: fov,
+                    orthographic,
                     ..CameraSettings::default()
                 };
             }

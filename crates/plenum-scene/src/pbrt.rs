@@ -2199,12 +2199,24 @@ impl Parser {
         }
         // pbrt's image x runs along camera +x; Plenum's along forward × up unless told.
         let left_handed = world_from_camera.vector(Vec3::X).dot(forward.cross(up)) < 0.0;
-        if ty != "perspective" {
+        if ty != "perspective" && ty != "orthographic" {
             self.warn(
                 &loc,
                 format!("the `{ty}` camera is not supported: a perspective camera"),
             );
         }
+        // pbrt's orthographic view is its screen window in camera units: by default
+        // [−1, 1] across the shorter image axis.
+        let orthographic = (ty == "orthographic").then(|| {
+            let window = params
+                .get("screenwindow")
+                .filter(|q| q.nums.len() == 4 && q.nums[3] > q.nums[2]);
+            match window {
+                Some(q) => q.nums[3] - q.nums[2],
+                None if w >= h => 2.0,
+                None => 2.0 * h / w,
+            }
+        });
         let fov = match self.float(&params, "fov", 90.0) {
             Ok(f) if f > 0.0 && f < 180.0 => f,
             _ => 90.0,
@@ -2220,7 +2232,25 @@ impl Parser {
             .unwrap_or(0.0)
             .max(0.0);
         let focus = self.float(&params, "focaldistance", 1e6).unwrap_or(1e6);
+        if orthographic.is_some() && radius > 0.0 {
+            self.warn(&loc, "a lens on an orthographic camera is not supported: its rays stay parallel, all in focus");
+        }
         for key in ["screenwindow", "frameaspectratio"] {
+            if key == "screenwindow" && orthographic.is_some() {
+                // Its height was read; a window off the axis, or of another aspect, is not.
+                if let Some(q) = params.get(key) {
+                    let n = &q.nums;
+                    let centred = n.len() == 4
+                        && (n[0] + n[1]).abs() < 1e-9
+                        && (n[2] + n[3]).abs() < 1e-9
+                        && ((n[1] - n[0]) / (n[3] - n[2]) - w / h).abs() < 1e-6;
+                    if !centred {
+                        let l = q.loc.clone();
+                        self.warn(&l, "an orthographic `screenwindow` off centre or of another aspect than the image's: its height is used, centred");
+                    }
+                }
+                continue;
+            }
             if let Some(q) = params.get(key) {
                 let l = q.loc.clone();
                 self.warn(
@@ -2257,6 +2287,7 @@ impl Parser {
             left_handed,
             shutter,
             motion,
+            orthographic,
             ..CameraSettings::default()
         };
     }

@@ -84,16 +84,23 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
     let c = &scene.camera;
     let _ = writeln!(
         w,
-        "[camera]\nposition = {}\nlook_at = {}\nup = {}\nfov = {:?}\nresolution = [{}, {}]",
+        "[camera]\nposition = {}\nlook_at = {}\nup = {}\nresolution = [{}, {}]",
         vec(c.position),
         vec(c.look_at),
         vec(c.up),
-        c.fov_degrees,
         defaults.width,
         defaults.height
     );
+    match c.orthographic {
+        Some(h) => {
+            let _ = writeln!(w, "orthographic = {h:?}");
+        }
+        None => {
+            let _ = writeln!(w, "fov = {:?}", c.fov_degrees);
+        }
+    }
     let _ = writeln!(w, "shutter = [{:?}, {:?}]", c.shutter[0], c.shutter[1]);
-    if c.lens.radius > 0.0 {
+    if c.lens.radius > 0.0 && c.orthographic.is_none() {
         let _ = writeln!(
             w,
             "aperture = {:?}\nfocus_distance = {:?}\nblades = {}\nblade_rotation = {:?}",

@@ -464,3 +464,57 @@ vertex_materials = ["r", "g", "b"]
         assert!((v - 1.0 / 3.0).abs() < 1e-6, "{c:?}");
     }
 }
+
+/// An orthographic camera: its rays are parallel, so a ball of radius 1 spans the same
+/// 2 / (4 / 64) = 32 pixels of a view 4 units high at any distance (a perspective camera's
+/// shrinks with distance); the scene writes back as it reads; the keys that mean nothing
+/// to it (a field of view, a lens) are located errors, and so is a height ≤ 0.
+#[test]
+fn an_orthographic_camera_sees_sizes_at_any_distance_alike() {
+    let width_of_ball = |camera: &str| {
+        let text = format!(
+            "background = [1, 1, 1]\n[camera]\nposition = [0, 0, {camera}\nlook_at = [0, 0, 0]\nresolution = [64, 64]\n\
+             [materials.black]\ndiffuse = 0\nambient = 0\n\
+             [[objects]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"black\"\n"
+        );
+        let l = parse_scene(Path::new("ortho.toml"), &text, Path::new(".")).unwrap();
+        let mut s = settings(&l);
+        s.sampler = PixelSampler::new(plenum_core::sampling::SamplerKind::Grid, 1);
+        let image = render(&l.scene, &s, &AtomicBool::new(false), &|_, _| {}).film;
+        let row = 32;
+        let dark = (0..64).filter(|&x| image.get(x, row).g < 0.5).count();
+        (dark, l)
+    };
+    for distance in ["5]\northographic = 4", "50]\northographic = 4"] {
+        let (dark, l) = width_of_ball(distance);
+        assert_eq!(dark, 32, "{distance}");
+        let written = plenum_scene::to_toml(&l.scene, &l.defaults);
+        assert!(written.contains("orthographic = 4.0"), "{written}");
+        let again = parse_scene(Path::new("again.toml"), &written, Path::new(".")).unwrap();
+        assert_eq!(again.scene.camera.orthographic, Some(4.0));
+    }
+    let (near, _) = width_of_ball("5]\nfov = 53.13");
+    let (far, _) = width_of_ball("50]\nfov = 53.13");
+    assert!(near > 2 * far, "perspective: {near} pixels near, {far} far");
+    for (keys, says) in [
+        (
+            "orthographic = 4\nfov = 30",
+            "an orthographic camera has no `fov`",
+        ),
+        (
+            "orthographic = 4\naperture = 0.1",
+            "an orthographic camera has no `aperture`",
+        ),
+        (
+            "orthographic = -1",
+            "expected the orthographic view's height",
+        ),
+    ] {
+        let text = format!("[camera]\n{keys}\n");
+        let e = parse_scene(Path::new("bad.toml"), &text, Path::new("."))
+            .err()
+            .unwrap_or_else(|| panic!("{keys}: accepted"))
+            .to_string();
+        assert!(e.contains(says) && e.contains("bad.toml:"), "{e}");
+    }
+}

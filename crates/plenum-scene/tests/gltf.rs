@@ -316,3 +316,19 @@ fn bad_files_are_refused_with_where() {
     let e = err(&text);
     assert!(e.message.contains("nodes"), "{e}");
 }
+
+/// An orthographic camera is one: its view 2·ymag high and 2·xmag wide (the image's aspect
+/// follows), with no warning.
+#[test]
+fn an_orthographic_camera_keeps_its_extent() {
+    let l = load(&document(
+        &data_uri(),
+        "0, 1",
+        r#"{"mesh": 0}, {"camera": 0, "translation": [0, 0, 4]}"#,
+        r#"{"emissiveFactor": [1, 1, 1]}"#,
+        r#", "cameras": [{"type": "orthographic", "orthographic": {"xmag": 3.0, "ymag": 1.5, "znear": 0.1, "zfar": 10}}]"#,
+    ));
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    assert_eq!(l.scene.camera.orthographic, Some(3.0));
+    assert_eq!((l.defaults.width, l.defaults.height), (960, 480));
+}

@@ -561,3 +561,28 @@ Shape "sphere"
         "{e}"
     );
 }
+
+/// pbrt's orthographic camera: its screen window, by default [−1, 1] across the shorter image
+/// axis, is the view; a window given sets its height.
+#[test]
+fn the_orthographic_camera_sees_its_screen_window() {
+    let camera = |extra: &str, film: &str| {
+        let l = load(&format!(
+            "LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"orthographic\" {extra}\nFilm \"rgb\" {film}\nWorldBegin\nShape \"sphere\"\n"
+        ));
+        assert!(
+            !l.warnings.iter().any(|w| w.contains("camera")),
+            "{:?}",
+            l.warnings
+        );
+        l.scene.camera.orthographic
+    };
+    let wide = "\"integer xresolution\" 64 \"integer yresolution\" 32";
+    let tall = "\"integer xresolution\" 32 \"integer yresolution\" 64";
+    assert_eq!(camera("", wide), Some(2.0));
+    assert_eq!(camera("", tall), Some(4.0));
+    assert_eq!(
+        camera("\"float screenwindow\" [ -4 4 -2 2 ]", wide),
+        Some(4.0)
+    );
+}

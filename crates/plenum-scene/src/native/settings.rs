@@ -162,6 +162,7 @@ impl<'s> Reader<'s> {
                 "position_close",
                 "look_at_close",
                 "left_handed",
+                "orthographic",
             ],
         )?;
         let c = CameraSettings::default();
@@ -238,6 +239,35 @@ impl<'s> Reader<'s> {
                 Some((p, l))
             }
         };
+        // A parallel projection: the view's height in scene units, with neither a field of
+        // view nor a lens (nothing for them to mean).
+        let orthographic = match f.get("orthographic") {
+            None => None,
+            Some(v) => {
+                let h = f.number_or("orthographic", 1.0)?;
+                if !(h > 0.0 && h.is_finite()) {
+                    return Err(self.src.error(
+                        v.span(),
+                        format!("expected the orthographic view's height in scene units, > 0, found {h}"),
+                    ));
+                }
+                for key in [
+                    "fov",
+                    "aperture",
+                    "f_number",
+                    "focal_length",
+                    "focus_distance",
+                ] {
+                    if let Some(k) = f.get(key) {
+                        return Err(self.src.error(
+                            k.span(),
+                            format!("an orthographic camera has no `{key}`: its view is `orthographic` scene units high, its rays parallel"),
+                        ));
+                    }
+                }
+                Some(h)
+            }
+        };
         self.builder.camera = CameraSettings {
             position,
             look_at,
@@ -247,6 +277,7 @@ impl<'s> Reader<'s> {
             shutter,
             motion,
             left_handed: f.bool_or("left_handed", false)?,
+            orthographic,
         };
         Ok(())
     }
