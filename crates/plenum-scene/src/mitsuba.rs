@@ -1239,8 +1239,12 @@ impl<'d> Builder<'d> {
                 );
             }
         }
+        // Mitsuba's orthographic sensor sees [−1, 1] across x of its frame and the film's
+        // aspect along y, scaled by its transform.
+        let orthographic = (ob.plugin == "orthographic")
+            .then(|| 2.0 * height as f64 / width as f64 * m.vector(Vec3::Y).length());
         let lens = match ob.plugin.as_str() {
-            "perspective" => Lens::default(),
+            "perspective" | "orthographic" => Lens::default(),
             "thinlens" => {
                 let Some(_) = self.prop(o, "aperture_radius") else {
                     return Err(self
@@ -1270,6 +1274,7 @@ impl<'d> Builder<'d> {
             fov_degrees: fov,
             lens,
             left_handed,
+            orthographic,
             ..CameraSettings::default()
         };
         self.defaults.width = width;
