@@ -314,6 +314,12 @@ fn shows_where_the_work_goes_and_the_scene_in_3d() {
             == 3));
     }
     assert_eq!(scene["camera"]["corners"].as_array().unwrap().len(), 4);
+    // A perspective camera's corner rays all start at the eye.
+    let origins = scene["camera"]["origins"].as_array().unwrap();
+    assert!(
+        origins.iter().all(|o| *o == scene["camera"]["position"]),
+        "{scene}"
+    );
     assert!(!scene["lights"].as_array().unwrap().is_empty(), "{scene}");
     let (_, tree) = json(&view, "GET", "/api/trace?x=16&y=12");
     assert!(tree["rays"]

@@ -1,7 +1,8 @@
 //! The scene as lines for the page's 3-D view (`/api/scene`): each object's outline in
 //! world space (a sphere's three great circles, a disk's rim, a polygon's edges, a small
 //! mesh's edges, any other object's box), each infinite plane as a grid about the scene,
-//! the camera's frustum to the image's corners, and the lights.
+//! the camera's frustum to the image's corners (a box for an orthographic camera: its
+//! corner rays start apart), and the lights.
 
 use plenum_core::camera::Camera;
 use plenum_core::geometry::Shape;
@@ -36,7 +37,9 @@ pub fn scene_json(scene: &Scene, width: u32, height: u32) -> Value {
     let eye = scene.camera.position;
     // The frustum to a plane at the distance of the scene's centre.
     let depth = (center - eye).length().max(radius * 0.5).max(1e-3);
-    let corners: Vec<[f64; 3]> = [
+    // The rays through the image's corners: where they start (the eye, or for an
+    // orthographic camera the corners of its view) and where they reach that plane.
+    let rays: Vec<([f64; 3], [f64; 3])> = [
         (0.0, 0.0),
         (width as f64, 0.0),
         (width as f64, height as f64),
@@ -48,9 +51,11 @@ pub fn scene_json(scene: &Scene, width: u32, height: u32) -> Value {
         let d = r.direction.normalized();
         let forward = (scene.camera.look_at - eye).normalized();
         let along = depth / d.dot(forward).max(1e-3);
-        xyz(r.origin + d * along)
+        (xyz(r.origin), xyz(r.origin + d * along))
     })
     .collect();
+    let origins: Vec<[f64; 3]> = rays.iter().map(|r| r.0).collect();
+    let corners: Vec<[f64; 3]> = rays.iter().map(|r| r.1).collect();
     let lights: Vec<Value> = scene
         .lights
         .iter()
@@ -69,7 +74,12 @@ pub fn scene_json(scene: &Scene, width: u32, height: u32) -> Value {
         "center": xyz(center),
         "radius": radius,
         "objects": objects,
-        "camera": { "position": xyz(eye), "up": xyz(scene.camera.up), "corners": corners },
+        "camera": {
+            "position": xyz(eye),
+            "up": xyz(scene.camera.up),
+            "origins": origins,
+            "corners": corners,
+        },
         "lights": lights,
     })
 }
@@ -154,4 +164,36 @@ fn box_edges(b: &Bounds3) -> Vec<Vec<Vec3>> {
         vec![p(t, t, f), p(t, t, t)],
         vec![p(f, t, f), p(f, t, t)],
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use plenum_core::accel::AccelKind;
+
+    /// The built-in scene's outline: every object drawn; through an orthographic camera
+    /// 2 units high the corner rays start 2 apart, top to bottom, and run parallel.
+    #[test]
+    fn an_orthographic_cameras_outline_is_a_box() {
+        let mut scene = plenum_scene::builtin_scene_with(AccelKind::Bvh).scene;
+        scene.camera.orthographic = Some(2.0);
+        let v = scene_json(&scene, 40, 30);
+        let objects = v["objects"].as_array().unwrap();
+        assert_eq!(objects.len(), scene.geometry.primitives.len());
+        assert!(objects
+            .iter()
+            .all(|o| !o["lines"].as_array().unwrap().is_empty()));
+        let point = |key: &str, i: usize| {
+            let p = &v["camera"][key][i];
+            Vec3::new(
+                p[0].as_f64().unwrap(),
+                p[1].as_f64().unwrap(),
+                p[2].as_f64().unwrap(),
+            )
+        };
+        let (top, bottom) = (point("origins", 0), point("origins", 3));
+        assert!(((top - bottom).length() - 2.0).abs() < 1e-9);
+        let (a, b) = (point("corners", 0) - top, point("corners", 3) - bottom);
+        assert!((a - b).length() < 1e-9, "{a:?} {b:?}");
+    }
 }
