@@ -209,7 +209,8 @@ fn pbrt() {
 }
 
 /// pbrt-v4 statements of random directives, parameters and numbers: the graphics state's
-/// stack, transformations, named materials and objects, meshes with bad indices.
+/// stack, transformations (at the start and end times too), `Attribute`, named materials
+/// and objects, meshes with bad indices, the orthographic camera.
 #[test]
 fn pbrt_statements() {
     const PIECES: &[&str] = &[
@@ -241,6 +242,15 @@ fn pbrt_statements() {
         "ObjectEnd\n",
         "ObjectInstance \"o\"\n",
         "Include \"other.pbrt\"\n",
+        "ActiveTransform StartTime\n",
+        "ActiveTransform EndTime\n",
+        "ActiveTransform All\n",
+        "TransformTimes 0 V\n",
+        "CoordinateSystem \"c\"\n",
+        "CoordSysTransform \"c\"\n",
+        "Attribute \"shape\" \"float radius\" V\n",
+        "Attribute \"light\" \"float scale\" V\n",
+        "Camera \"orthographic\" \"float screenwindow\" [ -V V -1 1 ] \"float shutterclose\" V\n",
     ];
     bolero::check!()
         .with_type::<Vec<(u8, i16)>>()
