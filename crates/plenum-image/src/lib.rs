@@ -189,9 +189,11 @@ pub fn write_exr_layers(
         .map_err(|e| wrap(e.into()))
 }
 
-/// The channels of an OpenEXR file's first part by name, each row-major from the top-left,
-/// with the image's width and height.
-pub fn read_exr_channels(path: &Path) -> Result<(u32, u32, Vec<(String, Vec<f32>)>), ImageError> {
+/// An image's channels: each one's name and values, row-major from the top-left.
+pub type Channels = Vec<(String, Vec<f32>)>;
+
+/// The channels of an OpenEXR file's first part by name, with the image's width and height.
+pub fn read_exr_channels(path: &Path) -> Result<(u32, u32, Channels), ImageError> {
     let image =
         exr::prelude::read_first_flat_layer_from_file(path).map_err(|e| ImageError::Read {
             path: path.display().to_string(),

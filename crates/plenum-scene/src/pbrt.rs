@@ -2288,7 +2288,6 @@ impl Parser {
             shutter,
             motion,
             orthographic,
-            ..CameraSettings::default()
         };
     }
 }
