@@ -290,6 +290,11 @@ fn a_click_on_the_glass_sphere_shows_its_ray_tree() {
         .as_str()
         .unwrap_or_else(|| panic!("no session: {session}"))
         .to_string();
+    // Ended however the test ends: the driver's browser outlives the driver otherwise.
+    let _session = Session {
+        port,
+        id: id.clone(),
+    };
     let at = |p: &str| format!("/session/{id}{p}");
     let script = |code: &str| {
         webdriver(
@@ -369,5 +374,27 @@ fn a_click_on_the_glass_sphere_shows_its_ray_tree() {
         "return document.body.dataset.shown === 'cost'",
         "the cost view",
     );
-    webdriver(port, "DELETE", &at(""), None);
+}
+
+/// A WebDriver session, deleted (its browser closed) when dropped.
+struct Session {
+    port: u16,
+    id: String,
+}
+
+impl Drop for Session {
+    /// Best effort and never a panic (it may run while a failed test unwinds).
+    fn drop(&mut self) {
+        if let Ok(mut s) = TcpStream::connect(("127.0.0.1", self.port)) {
+            let _ = s.set_read_timeout(Some(Duration::from_secs(10)));
+            let request = format!(
+                "DELETE /session/{} HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 0\r\n\r\n",
+                self.id
+            );
+            if s.write_all(request.as_bytes()).is_ok() {
+                // The browser is closed once the driver answers.
+                let _ = s.read(&mut [0u8; 256]);
+            }
+        }
+    }
 }
