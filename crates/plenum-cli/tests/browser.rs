@@ -71,6 +71,19 @@ fn headless(browser: &str, args: &[String], url: &str) -> String {
     out
 }
 
+/// The page's tree of the glass sphere's middle pixel: a camera ray hitting the glass, with
+/// reflected and refracted children.
+fn assert_glass_tree(tree: &str) {
+    assert!(
+        tree.contains(">camera<") && tree.contains("glass sphere"),
+        "{tree}"
+    );
+    assert!(
+        tree.contains(">reflected<") && tree.contains(">refracted<"),
+        "{tree}"
+    );
+}
+
 #[test]
 fn the_page_shows_the_image_and_a_pixels_ray_tree() {
     let Some(browser) = chromium() else {
@@ -95,14 +108,7 @@ fn the_page_shows_the_image_and_a_pixels_ray_tree() {
     );
     assert!(dom.contains("data-pixel=\"32,24\""), "no ray tree:\n{dom}");
     let tree = &dom[dom.find("id=\"tree\"").unwrap()..];
-    assert!(
-        tree.contains(">camera<") && tree.contains("glass sphere"),
-        "{tree}"
-    );
-    assert!(
-        tree.contains(">reflected<") && tree.contains(">refracted<"),
-        "{tree}"
-    );
+    assert_glass_tree(tree);
     let svg = &dom[dom.find("id=\"rays\"").unwrap()..];
     let svg = &svg[..svg.find("</svg>").unwrap()];
     assert!(
@@ -350,14 +356,7 @@ fn a_click_on_the_glass_sphere_shows_its_ray_tree() {
         "clicked pixel ({x}, {y})"
     );
     let tree = script("return document.getElementById('tree').innerHTML").to_string();
-    assert!(
-        tree.contains(">camera<") && tree.contains("glass sphere"),
-        "{tree}"
-    );
-    assert!(
-        tree.contains(">reflected<") && tree.contains(">refracted<"),
-        "{tree}"
-    );
+    assert_glass_tree(&tree);
     let overlay = script("return document.querySelectorAll('#rays line').length");
     assert!(overlay.as_u64() >= Some(3), "{overlay}");
     let segments = script("return +document.getElementById('space').dataset.segments");
