@@ -136,6 +136,7 @@ fn spawned_rays_never_rehit_their_surface() {
                 motion: None,
                 material: 0,
                 light: None,
+                alpha: None,
             };
             let Some(bounds) = prim.world_bounds() else {
                 continue;

@@ -230,6 +230,9 @@ pub struct Texels {
     pub width: usize,
     pub height: usize,
     pub rgb: Vec<[f32; 3]>,
+    /// The alpha channel, where the image has one: linear coverage in [0, 1], never
+    /// sRGB-decoded.
+    pub alpha: Option<Vec<f32>>,
 }
 
 /// Reads a texture: PNG or JPEG, whose 8- or 16-bit values are sRGB-encoded and decoded to
@@ -254,6 +257,10 @@ pub fn decode_texture(bytes: &[u8], name: &str) -> Result<Texels, ImageError> {
 
 fn texels(img: image::DynamicImage) -> Texels {
     let (w, h) = (img.width() as usize, img.height() as usize);
+    let alpha = img
+        .color()
+        .has_alpha()
+        .then(|| img.to_rgba32f().pixels().map(|p| p.0[3]).collect());
     let rgb = match img {
         image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_) => {
             img.to_rgb32f().pixels().map(|p| p.0).collect()
@@ -268,6 +275,7 @@ fn texels(img: image::DynamicImage) -> Texels {
         width: w,
         height: h,
         rgb,
+        alpha,
     }
 }
 

@@ -20,7 +20,7 @@ use plenum_core::material::{
     Material, Roughness, SpectralTexture, SpectrumKind, SpectrumValue,
 };
 use plenum_core::math::{Bounds3, Matrix4, Transform, Vec3};
-use plenum_core::scene::{MaterialId, SceneBuilder};
+use plenum_core::scene::{Alpha, MaterialId, SceneBuilder};
 use plenum_core::texture::{ImageTexture, Texture};
 use plenum_spectrum::Spectrum;
 use std::collections::HashMap;
@@ -149,11 +149,19 @@ struct Reader<'a> {
     warnings: Vec<String>,
     /// Each (mesh, primitive) read once, for every node that uses it.
     meshes: HashMap<(usize, usize), Option<Arc<TriangleMesh>>>,
-    /// Each material added once (None: glTF's default material), with its emission.
-    materials: HashMap<Option<usize>, (MaterialId, Color)>,
+    /// Each material added once (None: glTF's default material).
+    materials: HashMap<Option<usize>, Surface>,
     camera: Option<(gltf::Camera<'a>, Matrix4)>,
     bounds: Bounds3,
     lights: usize,
+}
+
+/// What a glTF material becomes: Plenum's material, the emission, the cut-out.
+#[derive(Clone)]
+struct Surface {
+    material: MaterialId,
+    emission: Color,
+    alpha: Option<Alpha>,
 }
 
 /// The column-major matrix glTF writes as Plenum's row-major one.
@@ -403,14 +411,13 @@ impl<'a> Reader<'a> {
         Ok(m)
     }
 
-    /// A texture as Plenum's image texture, times `factor`.
-    fn texture(
+    /// A texture's image, decoded (colour to linear, alpha as it is).
+    fn texels(
         &mut self,
         info: &gltf::texture::Info,
-        factor: [f64; 3],
         base: &Path,
         at: &str,
-    ) -> Result<Texture> {
+    ) -> Result<(plenum_image::Texels, String)> {
         if info.tex_coord() != 0 {
             self.warn(format!(
                 "{at}: texture coordinates {} are not supported: using TEXCOORD_0",
@@ -450,29 +457,55 @@ impl<'a> Reader<'a> {
             }
         }
         .map_err(|e| self.error(&iat, e))?;
-        let (width, height) = (texels.width, texels.height);
-        let texels = texels
-            .rgb
-            .iter()
-            .map(|p| {
-                Color::new(
-                    p[0] as f64 * factor[0],
-                    p[1] as f64 * factor[1],
-                    p[2] as f64 * factor[2],
-                )
-            })
-            .collect();
-        let image = ImageTexture::new(width, height, texels, [1.0, 1.0])
-            .ok_or_else(|| self.error(&iat, "the image is empty"))?;
+        Ok((texels, iat))
+    }
+
+    /// An image texture of `texels` mapped by `value` (a texel's RGB and alpha to a colour);
+    /// `iat` names the image.
+    fn image_texture(
+        &self,
+        texels: &plenum_image::Texels,
+        iat: &str,
+        value: impl Fn(usize) -> Color,
+    ) -> Result<Texture> {
+        let colors = (0..texels.rgb.len()).map(value).collect();
+        let image = ImageTexture::new(texels.width, texels.height, colors, [1.0, 1.0])
+            .ok_or_else(|| self.error(iat, "the image is empty"))?;
         Ok(Texture::Image(Arc::new(image)))
+    }
+
+    /// The material's cut-out (none for `OPAQUE`): the base colour's alpha, its factor times
+    /// its texture's alpha channel, compared with `alphaCutoff` under `MASK`; under `BLEND`,
+    /// a coverage, which the surface has stochastically (blending averaged over samples).
+    fn alpha(
+        &self,
+        m: &gltf::Material,
+        base_texels: Option<&(plenum_image::Texels, String)>,
+    ) -> Result<Option<Alpha>> {
+        let cutoff = match m.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => return Ok(None),
+            gltf::material::AlphaMode::Mask => Some(m.alpha_cutoff().unwrap_or(0.5) as f64),
+            gltf::material::AlphaMode::Blend => None,
+        };
+        let factor = m.pbr_metallic_roughness().base_color_factor()[3] as f64;
+        let texture = match base_texels {
+            Some((t, iat)) if t.alpha.is_some() => {
+                let alpha = t.alpha.as_deref().unwrap_or_default();
+                FloatTexture::Texture(
+                    self.image_texture(t, iat, |i| Color::gray(alpha[i] as f64 * factor))?,
+                )
+            }
+            _ => FloatTexture::Constant(factor),
+        };
+        Ok(Some(Alpha { texture, cutoff }))
     }
 
     /// A glTF material as Plenum's, and its emitted radiance: a dielectric coat over the base
     /// colour (`coateddiffuse`), a conductor of that colour (pbrt-v4's reflectance form) as
     /// far as it is metallic, glass as far as it transmits.
-    fn material(&mut self, m: &gltf::Material, base: &Path) -> Result<(MaterialId, Color)> {
-        if let Some(&done) = self.materials.get(&m.index()) {
-            return Ok(done);
+    fn material(&mut self, m: &gltf::Material, base: &Path) -> Result<Surface> {
+        if let Some(done) = self.materials.get(&m.index()) {
+            return Ok(done.clone());
         }
         let at = match m.index() {
             Some(i) => format!("materials[{i}]"),
@@ -481,13 +514,21 @@ impl<'a> Reader<'a> {
         let name = m.name().map(str::to_string).unwrap_or_else(|| at.clone());
         let pbr = m.pbr_metallic_roughness();
         let [r, g, b, _] = pbr.base_color_factor().map(|x| x as f64);
-        let base_color = match pbr.base_color_texture() {
-            Some(info) => SpectralTexture::from_texture(
-                self.texture(&info, [r, g, b], base, &format!("{at}.baseColorTexture"))?,
+        let base_texels = match pbr.base_color_texture() {
+            Some(info) => Some(self.texels(&info, base, &format!("{at}.baseColorTexture"))?),
+            None => None,
+        };
+        let base_color = match &base_texels {
+            Some((t, iat)) => SpectralTexture::from_texture(
+                self.image_texture(t, iat, |i| {
+                    let p = t.rgb[i];
+                    Color::new(p[0] as f64 * r, p[1] as f64 * g, p[2] as f64 * b)
+                })?,
                 SpectrumKind::Albedo,
             ),
             None => SpectralTexture::constant(Color::new(r, g, b), SpectrumKind::Albedo),
         };
+        let cut_out = self.alpha(m, base_texels.as_ref())?;
         if pbr.metallic_roughness_texture().is_some() {
             self.warn(format!(
                 "{at}: the metallicRoughnessTexture is not supported: using its factors"
@@ -514,12 +555,6 @@ impl<'a> Reader<'a> {
             }
             (t.transmission_factor() as f64).clamp(0.0, 1.0)
         });
-        if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
-            self.warn(format!(
-                "{at}: alphaMode {:?} is not supported: opaque",
-                m.alpha_mode()
-            ));
-        }
         if m.normal_texture().is_some() {
             self.warn(format!(
                 "{at}: the normalTexture is not supported: the surface is smooth"
@@ -598,8 +633,13 @@ impl<'a> Reader<'a> {
             _ => dielectric,
         };
         let id = self.builder.add_material(name, material);
-        self.materials.insert(m.index(), (id, emission));
-        Ok((id, emission))
+        let done = Surface {
+            material: id,
+            emission,
+            alpha: cut_out,
+        };
+        self.materials.insert(m.index(), done.clone());
+        Ok(done)
     }
 
     fn node(
@@ -629,7 +669,11 @@ impl<'a> Reader<'a> {
                         let Some(m) = self.mesh(&mesh, &p)? else {
                             continue;
                         };
-                        let (material, emission) = self.material(&p.material(), base)?;
+                        let Surface {
+                            material,
+                            emission,
+                            alpha,
+                        } = self.material(&p.material(), base)?;
                         self.bounds = self
                             .bounds
                             .union(&transformed_bounds(&m.bounds(), &to_world));
@@ -649,9 +693,15 @@ impl<'a> Reader<'a> {
                                 1,
                             );
                             self.lights += 1;
+                            if alpha.is_some() {
+                                self.warn(format!("{at}: an emissive material's alphaMode is not supported: the light is whole"));
+                            }
                         } else {
                             self.builder
                                 .add_object(pname, Shape::Mesh(m), to_world, material);
+                            if let Some(alpha) = alpha {
+                                self.builder.set_last_alpha(alpha);
+                            }
                         }
                     }
                 }

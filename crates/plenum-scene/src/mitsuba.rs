@@ -21,7 +21,7 @@ use plenum_core::material::{
 };
 use plenum_core::math::{Transform, Vec3};
 use plenum_core::sampling::{FilterKind, SamplerKind};
-use plenum_core::scene::{MaterialId, SceneBuilder};
+use plenum_core::scene::{Alpha, MaterialId, SceneBuilder};
 use plenum_core::texture::{ImageTexture, Texture};
 use plenum_spectrum::Spectrum;
 use std::collections::HashMap;
@@ -82,6 +82,7 @@ pub fn parse(
         },
         warnings: Vec::new(),
         materials: HashMap::new(),
+        opacities: HashMap::new(),
         default_diffuse: None,
         in_progress: Vec::new(),
         read: Vec::new(),
@@ -99,6 +100,8 @@ struct Builder<'d> {
     warnings: Vec<String>,
     /// BSDF objects already added.
     materials: HashMap<usize, MaterialId>,
+    /// Per BSDF object: the opacity of a `mask` it is or holds (through `twosided`).
+    opacities: HashMap<usize, FloatTexture>,
     default_diffuse: Option<MaterialId>,
     /// BSDFs being mapped, to refuse one that contains itself.
     in_progress: Vec<usize>,
@@ -653,8 +656,12 @@ impl<'d> Builder<'d> {
                     let l = p.loc.clone();
                     self.warn(&l, "a different BSDF for the back is not supported: the front one is used on both sides");
                 }
+                let material = self.bsdf(front, depth + 1)?.material;
+                if let Some(opacity) = self.opacities.get(&front).cloned() {
+                    self.opacities.insert(o, opacity);
+                }
                 Bsdf {
-                    material: self.bsdf(front, depth + 1)?.material,
+                    material,
                     two_sided: true,
                 }
             }
@@ -694,21 +701,54 @@ impl<'d> Builder<'d> {
                         .doc
                         .error(&ob.loc, format!("a {} needs a BSDF inside", ob.plugin)));
                 };
-                let what = match ob.plugin.as_str() {
-                    "mask" => "the opacity mask is not supported: the surface is opaque",
-                    _ => "bump and normal maps are not supported: the surface is smooth",
-                };
-                let l = ob.loc.clone();
-                self.warn(&l, what);
-                for key in ["opacity", "_arg_0"] {
-                    self.prop(o, key);
+                if ob.plugin == "mask" {
+                    // The opacity becomes a cut-out of the shapes that use this BSDF.
+                    let opacity = self.alpha(o, "opacity", 0.5)?;
+                    if let FloatTexture::Constant(a) = opacity {
+                        if a > 1.0 {
+                            let p = self.prop(o, "opacity").unwrap();
+                            return Err(self.doc.error(
+                                &p.loc,
+                                format!("expected an opacity between 0 and 1, found {a}"),
+                            ));
+                        }
+                    }
+                    self.opacities.insert(o, opacity);
+                } else {
+                    let l = ob.loc.clone();
+                    self.warn(
+                        &l,
+                        "bump and normal maps are not supported: the surface is smooth",
+                    );
                 }
+                self.prop(o, "_arg_0");
                 for p in &self.obj(o).props {
                     if matches!(p.value, Value::Object(_) | Value::Ref(_)) {
                         p.used.set(true);
                     }
                 }
-                self.bsdf(inner, depth + 1)?
+                let inner_bsdf = self.bsdf(inner, depth + 1)?;
+                // A mask around a mask: their opacities multiply, but only constants are
+                // multiplied here.
+                if let Some(inner_opacity) = self.opacities.get(&inner).cloned() {
+                    let outer = self.opacities.get(&o).cloned();
+                    let both = match (outer, inner_opacity) {
+                        (None, x) => x,
+                        (Some(FloatTexture::Constant(a)), FloatTexture::Constant(b)) => {
+                            FloatTexture::Constant(a * b)
+                        }
+                        (Some(x), _) => {
+                            let l = ob.loc.clone();
+                            self.warn(
+                                &l,
+                                "a mask inside a mask, with textures: the outer opacity is used",
+                            );
+                            x
+                        }
+                    };
+                    self.opacities.insert(o, both);
+                }
+                inner_bsdf
             }
             other => {
                 let l = ob.loc.clone();
@@ -858,6 +898,20 @@ impl<'d> Builder<'d> {
         if let Some(&(b, _)) = bsdfs.first() {
             return self.material(b, self.obj(o).id.as_deref());
         }
+        self.default_material(emits)
+    }
+
+    /// The cut-out of a shape whose BSDF is (or holds) a `mask`: its opacity, as coverage.
+    fn shape_cut_out(&self, o: usize) -> Result<Option<Alpha>> {
+        let bsdfs = self.children(o, "bsdf")?;
+        Ok(bsdfs
+            .first()
+            .and_then(|(b, _)| self.opacities.get(b))
+            .map(|opacity| Alpha::stochastic(opacity.clone())))
+    }
+
+    /// Mitsuba's BSDF for a shape without one.
+    fn default_material(&mut self, emits: bool) -> Result<MaterialId> {
         if emits {
             // Mitsuba gives an emitter without a BSDF a black diffuse one.
             return Ok(self.builder.black_material());
@@ -980,6 +1034,9 @@ impl<'d> Builder<'d> {
         let Some(&(e, ep)) = emitters.first() else {
             let material = self.shape_material(o, false)?;
             self.builder.add_object(name, shape, to_world, material);
+            if let Some(alpha) = self.shape_cut_out(o)? {
+                self.builder.set_last_alpha(alpha);
+            }
             return Ok(());
         };
         self.read.push(e);
@@ -994,6 +1051,13 @@ impl<'d> Builder<'d> {
         }
         let (radiance, spectrum) = self.emission(e, "radiance")?;
         let material = self.shape_material(o, true)?;
+        if self.shape_cut_out(o)?.is_some() {
+            let l = ep.loc.clone();
+            self.warn(
+                &l,
+                "a mask on an emitting shape is not supported: the light is whole",
+            );
+        }
         let added = self
             .builder
             .add_emissive_object(name, shape, to_world, material, radiance, false, 1);

@@ -21,7 +21,7 @@ use plenum_core::material::{
 };
 use plenum_core::math::{Matrix4, Transform, Vec3};
 use plenum_core::sampling::{FilterKind, SamplerKind};
-use plenum_core::scene::{MaterialId, SceneBuilder};
+use plenum_core::scene::{Alpha, MaterialId, SceneBuilder};
 use plenum_core::texture::{ImageTexture, Texture};
 use plenum_spectrum::Spectrum;
 use std::cell::Cell;
@@ -175,6 +175,7 @@ struct Recorded {
     /// At the end time.
     to_world_end: Matrix4,
     material: MaterialId,
+    alpha: Option<Alpha>,
 }
 
 struct Parser {
@@ -1142,6 +1143,9 @@ impl Parser {
                         .ok_or_else(singular)?;
                     self.builder
                         .add_object(format!("{name}/{}", r.name), r.shape, t, r.material);
+                    if let Some(alpha) = r.alpha {
+                        self.builder.set_last_alpha(alpha);
+                    }
                     if t_end != t {
                         self.builder.set_last_motion(t_end);
                     }
@@ -2099,12 +2103,24 @@ impl Parser {
                 ));
             }
         };
-        for key in ["alpha", "emissionfilename"] {
-            if let Some(q) = p.get(key) {
-                let l = q.loc.clone();
-                self.warn(&l, format!("`{key}` is not supported: ignored"));
-            }
+        if let Some(q) = p.get("emissionfilename") {
+            let l = q.loc.clone();
+            self.warn(&l, "`emissionfilename` is not supported: ignored");
         }
+        // A cut-out, tested stochastically as pbrt-v4 does. Light sampling would still see
+        // an area light's cut-away parts, so a light stays whole.
+        let alpha = match p.get("alpha") {
+            Some(q) if area.is_some() => {
+                let l = q.loc.clone();
+                self.warn(
+                    &l,
+                    "`alpha` on an area light is not supported: the light is whole",
+                );
+                None
+            }
+            Some(_) => Some(Alpha::stochastic(self.float_texture(p, "alpha", 1.0)?)),
+            None => None,
+        };
         let m = self.ctm().mul(&frame.matrix);
         let m_end = self.ctm_end().mul(&frame.matrix);
         let to_world = Transform::from_matrix(m)
@@ -2122,6 +2138,7 @@ impl Parser {
                 to_world: m,
                 to_world_end: m_end,
                 material,
+                alpha,
             });
             if area.is_some() {
                 self.warn(loc, "an area light inside an object instance is not supported (nor in pbrt-v4): not emitting");
@@ -2155,6 +2172,9 @@ impl Parser {
             }
             None => {
                 self.builder.add_object(name, shape, to_world, material);
+                if let Some(alpha) = alpha {
+                    self.builder.set_last_alpha(alpha);
+                }
                 if moves {
                     self.builder.set_last_motion(to_world_end);
                 }

@@ -398,6 +398,18 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                 matrix(&m.at(1.0))
             );
         }
+        if let Some(a) = &p.alpha {
+            let _ = match &a.texture {
+                FloatTexture::Constant(v) => writeln!(w, "alpha = {v:?}"),
+                FloatTexture::Texture(t) => writeln!(w, "alpha = {}", texture(t)),
+            };
+            // An image is written as its average: a cutoff would then cut all or nothing,
+            // so the average stays a coverage.
+            let image = matches!(a.texture, FloatTexture::Texture(Texture::Image(_)));
+            if let (Some(c), false) = (a.cutoff, image) {
+                let _ = writeln!(w, "alpha_cutoff = {c:?}");
+            }
+        }
         let _ = writeln!(w);
     }
     out

@@ -112,6 +112,7 @@ fn converted_scenes_render_the_same() {
         "prism.toml",
         "glass.toml",
         "rough-metals.toml",
+        "cut-outs.toml",
     ] {
         round_trip(load_scene(&examples.join(name)).unwrap(), name);
     }

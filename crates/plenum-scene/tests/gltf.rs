@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{bright_centre, load_files, native, number};
+use common::{bright_centre, load_files, native, number, png};
 
 use common::integrators::{draw, path_settings};
 use plenum_core::integrator::ColorMode;
@@ -331,4 +331,100 @@ fn an_orthographic_camera_keeps_its_extent() {
     assert!(l.warnings.is_empty(), "{:?}", l.warnings);
     assert_eq!(l.scene.camera.orthographic, Some(3.0));
     assert_eq!((l.defaults.width, l.defaults.height), (960, 480));
+}
+
+#[test]
+fn alpha_modes_cut_the_surface_out() {
+    // A black unit square (uvs over [0, 1]², glTF's v down the image) fills an orthographic
+    // view from z = 4; behind it at z = −1 a square ten times larger emits 1. The lamp shows
+    // where the front square is cut away.
+    let mut buffer = Vec::new();
+    let corners = [[-0.5f32, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]];
+    for [x, y] in corners {
+        for c in [x, y, 0.0] {
+            buffer.extend(c.to_le_bytes());
+        }
+    }
+    for [x, y] in corners {
+        for c in [x + 0.5, 0.5 - y] {
+            buffer.extend(c.to_le_bytes());
+        }
+    }
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        buffer.extend(i.to_le_bytes());
+    }
+    // Alpha 0 in the image's top-left and bottom-right texels, 255 in the others.
+    let texels = [0u8, 0, 0, 0, 9, 9, 9, 255, 9, 9, 9, 255, 0, 0, 0, 0];
+    let image = base64(&png(2, 2, 4, &texels));
+    let picture = |front: &str, spp: u32| {
+        let text = format!(
+            r#"{{
+  "asset": {{"version": "2.0"}},
+  "scene": 0,
+  "scenes": [{{"nodes": [0, 1, 2]}}],
+  "nodes": [
+    {{"mesh": 0}},
+    {{"mesh": 1, "translation": [0, 0, -1], "scale": [10, 10, 10]}},
+    {{"camera": 0, "translation": [0, 0, 4]}}
+  ],
+  "meshes": [
+    {{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1}}, "indices": 2, "material": 0}}]}},
+    {{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 2, "material": 1}}]}}
+  ],
+  "materials": [{front}, {{"emissiveFactor": [1, 1, 1], "pbrMetallicRoughness": {{"baseColorFactor": [0, 0, 0, 1]}}}}],
+  "images": [{{"uri": "data:image/png;base64,{image}"}}],
+  "textures": [{{"source": 0}}],
+  "cameras": [{{"type": "orthographic", "orthographic": {{"xmag": 0.5, "ymag": 0.5, "znear": 0.1, "zfar": 10}}}}],
+  "buffers": [{{"byteLength": 92, "uri": "data:application/octet-stream;base64,{}"}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": 32}}, {{"buffer": 0, "byteOffset": 80, "byteLength": 12}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-0.5, -0.5, 0], "max": [0.5, 0.5, 0]}},
+    {{"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"}},
+    {{"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}}
+  ]
+}}"#,
+            base64(&buffer)
+        );
+        let mut l = load(&text);
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        l.defaults.width = 32;
+        l.defaults.height = 32;
+        draw(&l, &path_settings(&l, spp, ColorMode::Rgb, 3))
+    };
+    // Black and metallic: the square reflects nothing.
+    let black = |alpha: &str| {
+        format!(
+            r#"{{{alpha} "pbrMetallicRoughness": {{"baseColorFactor": [0, 0, 0, FACTOR], "baseColorTexture": {{"index": 0}}}}}}"#
+        )
+    };
+    let green = |image: &[[f32; 3]], x: usize, y: usize| image[y * 32 + x][1];
+    // MASK by the texture's alpha: the lamp shows in the top-left and bottom-right.
+    let image = picture(&black(r#""alphaMode": "MASK","#).replace("FACTOR", "1"), 1);
+    for (x, y, lamp) in [(8, 8, true), (24, 24, true), (24, 8, false), (8, 24, false)] {
+        let want = if lamp { 1.0 } else { 0.0 };
+        assert!(
+            (green(&image, x, y) - want).abs() < 1e-3,
+            "({x}, {y}): {}",
+            green(&image, x, y)
+        );
+    }
+    // The factor's alpha multiplies the texture's: 0.4 < the cutoff 0.6 cuts it all away.
+    let image = picture(
+        &black(r#""alphaMode": "MASK", "alphaCutoff": 0.6,"#).replace("FACTOR", "0.4"),
+        1,
+    );
+    assert!(image.iter().all(|p| (p[1] - 1.0).abs() < 1e-3));
+    // OPAQUE (the default) ignores alpha: the lamp is hidden.
+    let image = picture(&black("").replace("FACTOR", "0.4"), 1);
+    assert!(image.iter().all(|p| p[1] == 0.0));
+    // BLEND with a coverage of 0.25 where the texture is opaque and 0 where it is not: the
+    // lamp is seen by 3/4 of the rays in two quadrants and all of them in the others, so the
+    // image's mean is 0.875. 32 × 32 × 16 = 16,384 samples, half of them random:
+    // σ = √(0.75·0.25/8192)/2 = 0.0024; 5σ.
+    let image = picture(
+        &black(r#""alphaMode": "BLEND","#).replace("FACTOR", "0.25"),
+        16,
+    );
+    let mean = image.iter().map(|p| p[1] as f64).sum::<f64>() / image.len() as f64;
+    assert!((mean - 0.875).abs() < 5.0 * 0.0024, "mean {mean}");
 }

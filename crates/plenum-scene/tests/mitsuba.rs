@@ -436,3 +436,61 @@ fn the_orthographic_sensor_sees_what_mitsuba_sees() {
         (Some(&40), Some(&55), 16)
     );
 }
+
+/// A `mask` BSDF cuts its shapes out by its opacity (a coverage), also inside a `twosided`:
+/// a black rectangle filling an orthographic view, of opacity 0.25, in front of a lamp of
+/// radiance 1 lets three quarters of the rays reach the lamp.
+#[test]
+fn a_mask_cuts_its_shapes_out_by_opacity() {
+    let picture = |bsdf: &str| {
+        load(&format!(
+            r#"<scene version="3.0.0">
+  <sensor type="orthographic">
+    <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/><rfilter type="box"/></film>
+  </sensor>
+  <shape type="rectangle">
+    <transform name="to_world"><scale value="10"/><translate z="-1"/></transform>
+    <emitter type="area"><rgb name="radiance" value="1"/></emitter>
+  </shape>
+  <shape type="rectangle">{bsdf}</shape>
+</scene>"#
+        ))
+    };
+    let black = r#"<bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf>"#;
+    for bsdf in [
+        format!(r#"<bsdf type="mask"><float name="opacity" value="0.25"/>{black}</bsdf>"#),
+        format!(
+            r#"<bsdf type="twosided"><bsdf type="mask"><float name="opacity" value="0.25"/>{black}</bsdf></bsdf>"#
+        ),
+        // Masks nested: 0.5 × 0.5.
+        format!(
+            r#"<bsdf type="mask"><float name="opacity" value="0.5"/><bsdf type="mask"><float name="opacity" value="0.5"/>{black}</bsdf></bsdf>"#
+        ),
+    ] {
+        let l = picture(&bsdf);
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        // 32 × 32 × 16 = 16,384 samples: σ = √(0.75·0.25/16384) = 0.0034; 5σ.
+        let image = draw(&l, &path_settings(&l, 16, ColorMode::Rgb, 3));
+        let mean = image.iter().map(|p| p[1] as f64).sum::<f64>() / image.len() as f64;
+        assert!((mean - 0.75).abs() < 5.0 * 0.0034, "{bsdf}: mean {mean}");
+    }
+    // Without a mask the rectangle hides the lamp.
+    let l = picture(black);
+    let image = draw(&l, &path_settings(&l, 1, ColorMode::Rgb, 3));
+    assert!(image.iter().all(|p| p[1] == 0.0));
+    // A texture is an opacity too; an opacity above 1 is an error where it is written.
+    let l = picture(&format!(
+        r#"<bsdf type="mask"><texture type="checkerboard" name="opacity"/>{black}</bsdf>"#
+    ));
+    let alpha = l.scene.geometry.primitives.last().unwrap().alpha.as_ref();
+    assert!(alpha.is_some_and(|a| a.needs_uv() && a.cutoff.is_none()));
+    let e = error(&scene(&format!(
+        r#"<shape type="rectangle"><bsdf type="mask">
+  <float name="opacity" value="1.5"/>{black}</bsdf></shape>"#
+    )));
+    assert!(
+        e.message.contains("between 0 and 1") && e.to_string().contains(":3:3"),
+        "{e}"
+    );
+}

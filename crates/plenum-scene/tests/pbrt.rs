@@ -586,3 +586,47 @@ fn the_orthographic_camera_sees_its_screen_window() {
         Some(4.0)
     );
 }
+
+#[test]
+fn alpha_cuts_a_shape_out_by_texture_or_by_coverage() {
+    // A black quad at z = 2 (so that no light bounces between it and the lamp) in front of a lamp of L = 1 at z = 3 that faces the camera: the
+    // lamp shows exactly where the quad is cut away. The quad's (u, v) run over [0, 2]², so
+    // a checkerboard of side 1 splits it into quadrants at the image's centre; pbrt's
+    // checkerboard gives tex1 where ⌊u⌋ + ⌊v⌋ is even: the bottom-left and top-right.
+    let picture = |alpha: &str, spp: u32| {
+        let l = load(&format!(
+            r#"LookAt 0 0 0  0 0 1  0 1 0
+Camera "perspective" "float fov" 60
+Film "rgb" "integer xresolution" 32 "integer yresolution" [ 32 ]
+Sampler "independent" "integer pixelsamples" {spp}
+WorldBegin
+Texture "cut" "float" "checkerboard" "float tex1" 0 "float tex2" 1
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 1 1 1 ]
+  Translate 0 0 3
+  Shape "bilinearmesh" "point3 P" [ -5 -5 0  -5 5 0  5 -5 0  5 5 0 ] "integer indices" [ 0 1 2 3 ]
+AttributeEnd
+Material "diffuse" "rgb reflectance" [ 0 0 0 ]
+Shape "trianglemesh" "point3 P" [ -5 -5 2  5 -5 2  5 5 2  -5 5 2 ]
+  "point2 uv" [ 0 0  2 0  2 2  0 2 ] "integer indices" [ 0 1 2  0 2 3 ] {alpha}
+"#
+        ));
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        draw(&l, &path_settings(&l, spp, ColorMode::Rgb, 5))
+    };
+    let image = picture(r#""texture alpha" "cut""#, 1);
+    let at = |x: usize, y: usize| image[y * 32 + x][1];
+    // Rows run from the top: the top-right and bottom-left quadrants see the lamp.
+    for (x, y, lamp) in [(24, 8, true), (8, 24, true), (8, 8, false), (24, 24, false)] {
+        let want = if lamp { 1.0 } else { 0.0 };
+        assert!((at(x, y) - want).abs() < 1e-3, "({x}, {y}): {}", at(x, y));
+    }
+    // A constant coverage of 0.25: three quarters of the rays reach the lamp. 32 × 32 × 16
+    // = 16,384 samples with independent hashes: σ = √(0.75·0.25/16384) = 0.0034; 5σ.
+    let image = picture(r#""float alpha" 0.25"#, 16);
+    let mean = image.iter().map(|p| p[1] as f64).sum::<f64>() / image.len() as f64;
+    assert!((mean - 0.75).abs() < 5.0 * 0.0034, "mean {mean}");
+    // Alpha 1 is opaque: the quad hides the lamp.
+    let image = picture(r#""float alpha" 1"#, 1);
+    assert!(image.iter().all(|p| p[1] == 0.0));
+}

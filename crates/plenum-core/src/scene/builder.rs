@@ -1,5 +1,6 @@
 //! Collects the parts of a scene (objects, materials, lights, camera), then builds it.
 
+use super::alpha::Alpha;
 use super::geometry::Geometry;
 use super::lights::Lights;
 use super::materials::Materials;
@@ -144,6 +145,7 @@ impl SceneBuilder {
             material,
             vertex_materials: None,
             light: None,
+            alpha: None,
         });
         self.object_names.push(name.into());
     }
@@ -162,6 +164,14 @@ impl SceneBuilder {
         self.add_object(name, Shape::Mesh(mesh), to_world, first);
         if let Some(p) = self.primitives.last_mut() {
             p.vertex_materials = Some(Arc::new(vertex_materials));
+        }
+    }
+
+    /// Cuts the last object added out where `alpha` says (see [`Alpha`]). An alpha that keeps
+    /// the whole surface is dropped, so that it costs nothing.
+    pub fn set_last_alpha(&mut self, alpha: Alpha) {
+        if let Some(p) = self.primitives.last_mut() {
+            p.alpha = (!alpha.is_opaque()).then(|| Arc::new(alpha));
         }
     }
 

@@ -2,6 +2,7 @@
 //! material table, its lights, the camera and the background. Built once by
 //! [`SceneBuilder`]; immutable and shared by every render thread.
 
+mod alpha;
 mod builder;
 mod geometry;
 mod lights;
@@ -9,6 +10,7 @@ mod materials;
 mod primitive;
 
 pub use crate::material::MaterialId;
+pub use alpha::Alpha;
 pub use builder::SceneBuilder;
 pub use geometry::Geometry;
 pub use lights::Lights;

@@ -1,10 +1,11 @@
 //! A shape placed in the world (a transform, perhaps moving, and a material), and a hit on it
 //! in world space.
 
+use super::alpha::Alpha;
 use crate::accel::Coherence;
 use crate::geometry::{HitRecord, Shape};
 use crate::material::MaterialId;
-use crate::math::{gamma, Bounds3, Motion, Ray, Transform, Vec3};
+use crate::math::{gamma, offset_ray_origin, Bounds3, Motion, Ray, Transform, Vec3};
 use crate::texture::TextureCoords;
 use std::sync::Arc;
 
@@ -23,7 +24,13 @@ pub struct Primitive {
     pub vertex_materials: Option<Arc<Vec<MaterialId>>>,
     /// The area light whose surface this is: hits on it see that light's emission.
     pub light: Option<u32>,
+    /// A cut-out: the surface is there only where this says (none: everywhere).
+    pub alpha: Option<Arc<Alpha>>,
 }
+
+/// The most cut-away hits one query passes on one primitive before it gives up and reports
+/// a miss: a bound that keeps a pathological mesh from stalling a ray.
+const MAX_CUTS: u32 = 1024;
 
 /// Everything the integrator needs about a hit, in world space.
 #[derive(Clone, Copy, Debug)]
@@ -50,7 +57,49 @@ impl Primitive {
         }
     }
 
+    /// The nearest hit in (0, t_max) where the surface is present.
+    #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
+        let hit = self.intersect_shape(ray, t_max)?;
+        match &self.alpha {
+            None => Some(hit),
+            Some(alpha) => self.past_cut_outs(alpha, ray, t_max, hit),
+        }
+    }
+
+    /// The nearest hit from `hit` on where the surface is present. As pbrt-v4 does, a ray
+    /// that meets a cut-away part goes on from just past it (its origin pushed beyond the
+    /// hit's error bounds, so it cannot meet the same point again), and distances are kept
+    /// along the first ray.
+    #[inline(never)]
+    fn past_cut_outs(
+        &self,
+        alpha: &Alpha,
+        ray: &Ray,
+        t_max: f64,
+        mut hit: HitRecord,
+    ) -> Option<HitRecord> {
+        if alpha.is_absent() {
+            return None;
+        }
+        let want_uv = alpha.needs_uv();
+        let mut from = *ray;
+        let mut t_from = 0.0;
+        for _ in 0..MAX_CUTS {
+            let it = self.interaction(&from, &hit, 0, want_uv);
+            if alpha.keeps(&it.texture, || super::hash_hit(it.p, ray.direction)) {
+                hit.t += t_from;
+                return Some(hit);
+            }
+            from.origin = offset_ray_origin(it.p, it.p_error, it.n, ray.direction);
+            t_from = (from.origin - ray.origin).dot(ray.direction) / ray.direction.length_squared();
+            hit = self.intersect_shape(&from, t_max - t_from)?;
+        }
+        None
+    }
+
+    /// The nearest hit on the shape in (0, t_max), cut-outs or not.
+    fn intersect_shape(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
         self.placed(ray.time, |placement| match placement {
             None => self.shape.intersect(ray, t_max),
             Some(t) => {
@@ -125,7 +174,11 @@ impl Primitive {
     }
 
     /// Some hit in (0, t_max), not necessarily the nearest (see [`Shape::intersect_any`]).
+    /// Past a cut-out the nearest is sought, so that no present part before it is missed.
     pub fn intersect_any(&self, ray: &Ray, t_max: f64, coherence: Coherence) -> Option<HitRecord> {
+        if self.alpha.is_some() {
+            return self.intersect(ray, t_max);
+        }
         self.placed(ray.time, |placement| match placement {
             None => self.shape.intersect_any(ray, t_max, coherence),
             Some(t) => {

@@ -33,7 +33,15 @@ mod objects;
 mod physical;
 mod settings;
 
-const COMMON: [&str; 5] = ["type", "name", "material", "transform", "transform_close"];
+const COMMON: [&str; 7] = [
+    "type",
+    "name",
+    "material",
+    "transform",
+    "transform_close",
+    "alpha",
+    "alpha_cutoff",
+];
 
 /// Parses a native scene. `base_dir` resolves relative paths (meshes, textures).
 /// Also returns warnings: statements of referenced mesh files that were read past.
@@ -151,9 +159,11 @@ impl<'s> Reader<'s> {
             return Ok(Texture::Constant(self.color(v)?));
         };
         let kind = {
-            let f = self
-                .src
-                .table(v, "a texture", &["texture", "even", "odd", "scale", "file"])?;
+            let f = self.src.table(
+                v,
+                "a texture",
+                &["texture", "even", "odd", "scale", "file", "channel"],
+            )?;
             let k = f.required("texture")?;
             (self.src.string(k)?.to_string(), k.span())
         };
@@ -172,9 +182,11 @@ impl<'s> Reader<'s> {
                 })
             }
             "image" => {
-                let f = self
-                    .src
-                    .table(v, "an image texture", &["texture", "file", "scale"])?;
+                let f = self.src.table(
+                    v,
+                    "an image texture",
+                    &["texture", "file", "scale", "channel"],
+                )?;
                 let file = f.required("file")?;
                 let path = self.base_dir.join(self.src.string(file)?);
                 let texels = plenum_image::read_texture(&path)
@@ -190,11 +202,31 @@ impl<'s> Reader<'s> {
                     }
                 };
                 let (width, height) = (texels.width, texels.height);
-                let texels = texels
-                    .rgb
-                    .iter()
-                    .map(|p| Color::new(p[0] as f64, p[1] as f64, p[2] as f64))
-                    .collect();
+                // The colour, or the alpha channel as grey (a cut-out's coverage).
+                let alpha = match f.get("channel") {
+                    None => false,
+                    Some(c) => match self.src.string(c)? {
+                        "rgb" => false,
+                        "alpha" if texels.alpha.is_some() => true,
+                        "alpha" => {
+                            return Err(self.src.error(c.span(), "the image has no alpha channel"))
+                        }
+                        other => {
+                            return Err(self.src.error(
+                                c.span(),
+                                format!("unknown channel `{other}`: expected \"rgb\" or \"alpha\""),
+                            ))
+                        }
+                    },
+                };
+                let texels = match (&texels.alpha, alpha) {
+                    (Some(a), true) => a.iter().map(|&a| Color::gray(a as f64)).collect(),
+                    _ => texels
+                        .rgb
+                        .iter()
+                        .map(|p| Color::new(p[0] as f64, p[1] as f64, p[2] as f64))
+                        .collect(),
+                };
                 let image = ImageTexture::new(width, height, texels, scale)
                     .ok_or_else(|| self.src.error(file.span(), "the image is empty"))?;
                 Ok(Texture::Image(Arc::new(image)))

@@ -8,9 +8,10 @@ use crate::{obj, ply};
 use plenum_core::geometry::{
     Cone, Cuboid, Cylinder, Disk, Plane, Polygon, Polyhedron, Shape, Sphere, TriangleMesh,
 };
-use plenum_core::material::PhongMaterial;
+use plenum_core::material::{FloatTexture, PhongMaterial};
 use plenum_core::math::{Transform, Vec3};
-use plenum_core::scene::MaterialId;
+use plenum_core::scene::{Alpha, MaterialId};
+use plenum_core::texture::Texture;
 use std::sync::Arc;
 
 impl<'s> Reader<'s> {
@@ -75,7 +76,14 @@ impl<'s> Reader<'s> {
             Some(t) => Some(self.transform(t)?.after(&frame)),
             None => None,
         };
+        let alpha = self.alpha(&f)?;
         if let Some(e) = f.get("emission") {
+            if let Some(a) = f.get("alpha") {
+                return Err(self.src.error(
+                    a.span(),
+                    "an emitting object cannot be cut out: drop `alpha`",
+                ));
+            }
             if f.get("vertex_materials").is_some() {
                 return Err(self.src.error(
                     e.span(),
@@ -140,7 +148,43 @@ impl<'s> Reader<'s> {
         if let Some(close) = close {
             self.builder.set_last_motion(close);
         }
+        if let Some(alpha) = alpha {
+            self.builder.set_last_alpha(alpha);
+        }
         Ok(())
+    }
+
+    /// `alpha` (a number in [0, 1] or a texture: the surface's coverage) and `alpha_cutoff`
+    /// (present exactly where alpha reaches it; without it, present with probability alpha).
+    fn alpha(&self, f: &Fields<'_, 's>) -> Result<Option<Alpha>> {
+        let cutoff = match f.get("alpha_cutoff") {
+            None => None,
+            Some(v) => {
+                if f.get("alpha").is_none() {
+                    return Err(self
+                        .src
+                        .error(v.span(), "`alpha_cutoff` needs an `alpha` to compare"));
+                }
+                Some(f.number_or("alpha_cutoff", 0.5)?)
+            }
+        };
+        let Some(v) = f.get("alpha") else {
+            return Ok(None);
+        };
+        let texture = match self.texture(v)? {
+            Texture::Constant(c) => {
+                let a = (c.r + c.g + c.b) / 3.0;
+                if !(0.0..=1.0).contains(&a) {
+                    return Err(self.src.error(
+                        v.span(),
+                        format!("expected an alpha between 0 and 1, found {a}"),
+                    ));
+                }
+                FloatTexture::Constant(a)
+            }
+            t => FloatTexture::Texture(t),
+        };
+        Ok(Some(Alpha { texture, cutoff }))
     }
 
     /// The material a `material` value names; none given: the default matte grey.

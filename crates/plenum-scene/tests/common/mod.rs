@@ -69,3 +69,49 @@ pub fn bright_centre(image: &[[f32; 3]], width: usize) -> (f64, f64) {
     assert!(n > 0.0, "the lamp is seen");
     (sx / n, sy / n)
 }
+
+/// An 8-bit PNG of `samples` (rows from the top), RGB if `channels` is 3, RGBA if 4, stored
+/// as PNG's format says: the signature, IHDR, one zlib IDAT of filter-0 rows, IEND, each
+/// chunk with its CRC-32.
+#[allow(dead_code)]
+pub fn png(width: u32, height: u32, channels: u8, samples: &[u8]) -> Vec<u8> {
+    use std::io::Write;
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut c = !0u32;
+        for &b in bytes {
+            c ^= b as u32;
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    0xEDB8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    }
+    let chunk = |out: &mut Vec<u8>, kind: &[u8], data: &[u8]| {
+        out.extend((data.len() as u32).to_be_bytes());
+        let body = [kind, data].concat();
+        out.extend(&body);
+        out.extend(crc32(&body).to_be_bytes());
+    };
+    let mut raw = Vec::new();
+    for row in samples.chunks(width as usize * channels as usize) {
+        raw.push(0);
+        raw.extend(row);
+    }
+    let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+    z.write_all(&raw).unwrap();
+    let idat = z.finish().unwrap();
+    let mut ihdr = Vec::new();
+    ihdr.extend(width.to_be_bytes());
+    ihdr.extend(height.to_be_bytes());
+    let colour_type = if channels == 4 { 6 } else { 2 };
+    ihdr.extend([8, colour_type, 0, 0, 0]);
+    let mut out = b"\x89PNG\r\n\x1a\n".to_vec();
+    chunk(&mut out, b"IHDR", &ihdr);
+    chunk(&mut out, b"IDAT", &idat);
+    chunk(&mut out, b"IEND", &[]);
+    out
+}

@@ -1,0 +1,131 @@
+//! Cut-outs in the native format: `alpha` (a number or a texture, an image's alpha channel
+//! among them) and `alpha_cutoff` on objects, their located errors, and `plenum convert`
+//! writing them back.
+
+mod common;
+
+use common::integrators::{draw, path_settings};
+use common::{load_files, png};
+use plenum_core::integrator::ColorMode;
+use plenum_scene::SceneError;
+
+/// A unit square at z = 0 filling an orthographic view from z = 4, cut by `alpha`, in front
+/// of a lamp of radiance 1 at z = −1.
+fn scene(alpha: &str) -> String {
+    format!(
+        r#"[camera]
+position = [0, 0, 4]
+look_at = [0, 0, 0]
+orthographic = 1.0
+resolution = [32, 32]
+
+[materials.black]
+type = "diffuse"
+reflectance = 0.0
+
+[[objects]]
+type = "polygon"
+name = "lamp"
+vertices = [[-5, -5, -1], [5, -5, -1], [5, 5, -1], [-5, 5, -1]]
+emission = 1.0
+
+[[objects]]
+type = "polygon"
+name = "square"
+material = "black"
+vertices = [[-0.5, -0.5, 0], [0.5, -0.5, 0], [0.5, 0.5, 0], [-0.5, 0.5, 0]]
+{alpha}
+"#
+    )
+}
+
+/// A 2 × 2 RGBA image: alpha 0 in its top-left and bottom-right texels, 1 in the others.
+fn diagonal_png() -> Vec<u8> {
+    png(
+        2,
+        2,
+        4,
+        &[0, 0, 0, 0, 9, 9, 9, 255, 9, 9, 9, 255, 0, 0, 0, 0],
+    )
+}
+
+fn error(toml: &str) -> SceneError {
+    match load_files(&[("scene.toml", toml.as_bytes()), ("a.png", &diagonal_png())]) {
+        Ok(_) => panic!("expected an error"),
+        Err(e) => e,
+    }
+}
+
+#[test]
+fn an_images_alpha_channel_cuts_by_its_cutoff() {
+    let text = scene(
+        "alpha = { texture = \"image\", file = \"a.png\", channel = \"alpha\" }\nalpha_cutoff = 0.5",
+    );
+    let l = load_files(&[("scene.toml", text.as_bytes()), ("a.png", &diagonal_png())])
+        .unwrap_or_else(|e| panic!("{e}"));
+    let image = draw(&l, &path_settings(&l, 1, ColorMode::Rgb, 3));
+    let at = |x: usize, y: usize| image[y * 32 + x][1];
+    // The image's (0, 0) is its bottom-left, at the polygon's first vertex: its cut texels
+    // land on the view's top-left and bottom-right.
+    for (x, y, lamp) in [(8, 8, true), (24, 24, true), (24, 8, false), (8, 24, false)] {
+        let want = if lamp { 1.0 } else { 0.0 };
+        assert!((at(x, y) - want).abs() < 1e-3, "({x}, {y}): {}", at(x, y));
+    }
+    // Without `channel`, the colour is read: dark everywhere (9/255 or 0), below the cutoff
+    // everywhere, so the whole square is cut away.
+    let text = scene("alpha = { texture = \"image\", file = \"a.png\" }\nalpha_cutoff = 0.5");
+    let l = load_files(&[("scene.toml", text.as_bytes()), ("a.png", &diagonal_png())]).unwrap();
+    let image = draw(&l, &path_settings(&l, 1, ColorMode::Rgb, 3));
+    assert!(image.iter().all(|p| (p[1] - 1.0).abs() < 1e-3));
+}
+
+#[test]
+fn a_constant_alpha_is_a_coverage_and_survives_convert() {
+    let text = scene("alpha = 0.25");
+    let l = load_files(&[("scene.toml", text.as_bytes())]).unwrap();
+    // 32 × 32 × 16 samples: σ = √(0.75·0.25/16384) = 0.0034; 5σ.
+    let image = draw(&l, &path_settings(&l, 16, ColorMode::Rgb, 3));
+    let mean = image.iter().map(|p| p[1] as f64).sum::<f64>() / image.len() as f64;
+    assert!((mean - 0.75).abs() < 5.0 * 0.0034, "mean {mean}");
+    let written = plenum_scene::to_toml(&l.scene, &l.defaults);
+    assert!(written.contains("alpha = 0.25"), "{written}");
+    let text = scene(
+        "alpha = { texture = \"checker\", even = 1.0, odd = 0.0, scale = 2.0 }\nalpha_cutoff = 0.5",
+    );
+    let l = load_files(&[("scene.toml", text.as_bytes())]).unwrap();
+    let written = plenum_scene::to_toml(&l.scene, &l.defaults);
+    assert!(
+        written.contains("alpha = { texture = \"checker\"")
+            && written.contains("alpha_cutoff = 0.5"),
+        "{written}"
+    );
+}
+
+#[test]
+fn bad_alphas_are_located_errors() {
+    let at_square = |e: &SceneError, line: usize, what: &str| {
+        let s = e.to_string();
+        assert!(s.contains(&format!(":{line}:")) && s.contains(what), "{s}");
+    };
+    // The square's extra keys start on line 22.
+    at_square(&error(&scene("alpha = 1.5")), 22, "between 0 and 1");
+    at_square(&error(&scene("alpha_cutoff = 0.5")), 22, "needs an `alpha`");
+    at_square(
+        &error(&scene(
+            "alpha = { texture = \"image\", file = \"a.png\", channel = \"red\" }",
+        )),
+        22,
+        "unknown channel",
+    );
+    let rgb_only = png(1, 1, 3, &[1, 2, 3]);
+    let text = scene("alpha = { texture = \"image\", file = \"b.png\", channel = \"alpha\" }");
+    let e = match load_files(&[("scene.toml", text.as_bytes()), ("b.png", &rgb_only)]) {
+        Ok(_) => panic!("expected an error"),
+        Err(e) => e,
+    };
+    at_square(&e, 22, "no alpha channel");
+    // An emitting object cannot be cut out.
+    let e = error(&scene("").replace("emission = 1.0", "emission = 1.0\nalpha = 0.5"));
+    let s = e.to_string();
+    assert!(s.contains(":16:") && s.contains("cannot be cut out"), "{s}");
+}
