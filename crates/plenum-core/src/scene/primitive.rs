@@ -49,7 +49,7 @@ pub struct Interaction {
 
 impl Primitive {
     /// Calls `f` with the object-to-world transform at `time` (`None`: identity).
-    #[inline]
+    #[inline(always)]
     fn placed<R>(&self, time: f64, f: impl FnOnce(Option<&Transform>) -> R) -> R {
         match &self.motion {
             None => f(self.to_world.as_deref()),
@@ -58,12 +58,12 @@ impl Primitive {
     }
 
     /// The nearest hit in (0, t_max) where the surface is present.
-    #[inline]
+    #[inline(never)]
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
-        let hit = self.intersect_shape(ray, t_max)?;
+        let hit = self.intersect_shape(ray, t_max);
         match &self.alpha {
-            None => Some(hit),
-            Some(alpha) => self.past_cut_outs(alpha, ray, t_max, hit),
+            None => hit,
+            Some(alpha) => self.past_cut_outs(alpha, ray, t_max, hit?),
         }
     }
 
@@ -71,6 +71,7 @@ impl Primitive {
     /// that meets a cut-away part goes on from just past it (its origin pushed beyond the
     /// hit's error bounds, so it cannot meet the same point again), and distances are kept
     /// along the first ray.
+    #[cold]
     #[inline(never)]
     fn past_cut_outs(
         &self,
@@ -99,6 +100,7 @@ impl Primitive {
     }
 
     /// The nearest hit on the shape in (0, t_max), cut-outs or not.
+    #[inline(always)]
     fn intersect_shape(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
         self.placed(ray.time, |placement| match placement {
             None => self.shape.intersect(ray, t_max),
