@@ -255,7 +255,22 @@ pub fn decode_texture(bytes: &[u8], name: &str) -> Result<Texels, ImageError> {
     Ok(texels(img))
 }
 
+/// [`decode_texture`] of an image that holds data rather than colour (glTF's metallic and
+/// roughness): 8- and 16-bit values are scaled to [0, 1] as they are, not sRGB-decoded.
+pub fn decode_data_texture(bytes: &[u8], name: &str) -> Result<Texels, ImageError> {
+    let img = image::load_from_memory(bytes).map_err(|e| ImageError::Read {
+        path: name.to_string(),
+        source: e.into(),
+    })?;
+    Ok(texels_as(img, false))
+}
+
 fn texels(img: image::DynamicImage) -> Texels {
+    texels_as(img, true)
+}
+
+/// The image's texels, its 8- and 16-bit values sRGB-decoded if `colour`.
+fn texels_as(img: image::DynamicImage, colour: bool) -> Texels {
     let (w, h) = (img.width() as usize, img.height() as usize);
     let alpha = img
         .color()
@@ -265,6 +280,7 @@ fn texels(img: image::DynamicImage) -> Texels {
         image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_) => {
             img.to_rgb32f().pixels().map(|p| p.0).collect()
         }
+        _ if !colour => img.to_rgb32f().pixels().map(|p| p.0).collect(),
         _ => img
             .to_rgb32f()
             .pixels()

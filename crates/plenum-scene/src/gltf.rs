@@ -411,10 +411,12 @@ impl<'a> Reader<'a> {
         Ok(m)
     }
 
-    /// A texture's image, decoded (colour to linear, alpha as it is).
+    /// A texture's image, decoded: colour to linear if `colour`, else (data such as
+    /// roughness) as stored; alpha as it is.
     fn texels(
         &mut self,
         info: &gltf::texture::Info,
+        colour: bool,
         base: &Path,
         at: &str,
     ) -> Result<(plenum_image::Texels, String)> {
@@ -439,6 +441,10 @@ impl<'a> Reader<'a> {
         }
         let image = info.texture().source();
         let iat = format!("images[{}]", image.index());
+        let decode = match colour {
+            true => plenum_image::decode_texture,
+            false => plenum_image::decode_data_texture,
+        };
         let texels = match image.source() {
             gltf::image::Source::View { view, .. } => {
                 let buffer = &self.buffers[view.buffer().index()];
@@ -449,11 +455,11 @@ impl<'a> Reader<'a> {
                     .ok_or_else(|| {
                         self.error(&iat, "its bufferView reaches past the end of its buffer")
                     })?;
-                plenum_image::decode_texture(bytes, &iat)
+                decode(bytes, &iat)
             }
             gltf::image::Source::Uri { uri, .. } => {
                 let bytes = self.uri(uri, base, &iat)?;
-                plenum_image::decode_texture(&bytes, uri)
+                decode(&bytes, uri)
             }
         }
         .map_err(|e| self.error(&iat, e))?;
@@ -515,7 +521,9 @@ impl<'a> Reader<'a> {
         let pbr = m.pbr_metallic_roughness();
         let [r, g, b, _] = pbr.base_color_factor().map(|x| x as f64);
         let base_texels = match pbr.base_color_texture() {
-            Some(info) => Some(self.texels(&info, base, &format!("{at}.baseColorTexture"))?),
+            Some(info) => {
+                Some(self.texels(&info, true, base, &format!("{at}.baseColorTexture"))?)
+            }
             None => None,
         };
         let base_color = match &base_texels {
@@ -529,18 +537,40 @@ impl<'a> Reader<'a> {
             None => SpectralTexture::constant(Color::new(r, g, b), SpectrumKind::Albedo),
         };
         let cut_out = self.alpha(m, base_texels.as_ref())?;
-        if pbr.metallic_roughness_texture().is_some() {
-            self.warn(format!(
-                "{at}: the metallicRoughnessTexture is not supported: using its factors"
-            ));
-        }
-        let alpha = (pbr.roughness_factor() as f64).clamp(0.0, 1.0).powi(2);
+        // Roughness in the green channel, metallic in the blue, times their factors.
+        let rough_factor = (pbr.roughness_factor() as f64).clamp(0.0, 1.0);
+        let metal_factor = (pbr.metallic_factor() as f64).clamp(0.0, 1.0);
+        let (alpha, metallic) = match pbr.metallic_roughness_texture() {
+            Some(info) => {
+                let what = format!("{at}.metallicRoughnessTexture");
+                let (t, iat) = self.texels(&info, false, base, &what)?;
+                let channel = |c: usize, factor: f64| {
+                    self.image_texture(&t, &iat, |i| {
+                        Color::gray((t.rgb[i][c] as f64).clamp(0.0, 1.0) * factor)
+                    })
+                };
+                // α = roughness², per texel.
+                let alpha = self.image_texture(&t, &iat, |i| {
+                    Color::gray(((t.rgb[i][1] as f64).clamp(0.0, 1.0) * rough_factor).powi(2))
+                })?;
+                (
+                    FloatTexture::Texture(alpha),
+                    match metal_factor {
+                        0.0 => FloatTexture::Constant(0.0),
+                        _ => FloatTexture::Texture(channel(2, metal_factor)?),
+                    },
+                )
+            }
+            None => (
+                FloatTexture::Constant(rough_factor.powi(2)),
+                FloatTexture::Constant(metal_factor),
+            ),
+        };
         let roughness = Roughness {
-            u: FloatTexture::Constant(alpha),
-            v: FloatTexture::Constant(alpha),
+            u: alpha.clone(),
+            v: alpha,
             remap: false,
         };
-        let metallic = (pbr.metallic_factor() as f64).clamp(0.0, 1.0);
         let ior = m.ior().map_or(1.5, |x| x as f64);
         if !(ior >= 1.0 && ior.is_finite()) {
             return Err(self.error(&at, format!("an ior of {ior}: expected 1 or more")));
@@ -621,16 +651,16 @@ impl<'a> Reader<'a> {
             _ => coat,
         };
         let material = match metallic {
-            x if x >= 1.0 => metal(),
-            x if x > 0.0 => {
+            FloatTexture::Constant(x) if x >= 1.0 => metal(),
+            FloatTexture::Constant(x) if x <= 0.0 => dielectric,
+            amount => {
                 let a = add(&mut self.builder, " (dielectric)", dielectric);
                 let b = add(&mut self.builder, " (metal)", metal());
                 Material::Mix {
                     materials: [a, b],
-                    amount: FloatTexture::Constant(x),
+                    amount,
                 }
             }
-            _ => dielectric,
         };
         let id = self.builder.add_material(name, material);
         let done = Surface {

@@ -333,11 +333,10 @@ fn an_orthographic_camera_keeps_its_extent() {
     assert_eq!((l.defaults.width, l.defaults.height), (960, 480));
 }
 
-#[test]
-fn alpha_modes_cut_the_surface_out() {
-    // A black unit square (uvs over [0, 1]², glTF's v down the image) fills an orthographic
-    // view from z = 4; behind it at z = −1 a square ten times larger emits 1. The lamp shows
-    // where the front square is cut away.
+/// A unit square (uvs over [0, 1]², glTF's v down the image) with material `front` and the
+/// PNG `image` as texture 0, filling an orthographic view from z = 4; behind it at z = −1 a
+/// square ten times larger emits 1.
+fn textured_square(front: &str, image: &[u8]) -> LoadedScene {
     let mut buffer = Vec::new();
     let corners = [[-0.5f32, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]];
     for [x, y] in corners {
@@ -353,12 +352,9 @@ fn alpha_modes_cut_the_surface_out() {
     for i in [0u16, 1, 2, 0, 2, 3] {
         buffer.extend(i.to_le_bytes());
     }
-    // Alpha 0 in the image's top-left and bottom-right texels, 255 in the others.
-    let texels = [0u8, 0, 0, 0, 9, 9, 9, 255, 9, 9, 9, 255, 0, 0, 0, 0];
-    let image = base64(&png(2, 2, 4, &texels));
-    let picture = |front: &str, spp: u32| {
-        let text = format!(
-            r#"{{
+    let image = base64(image);
+    let text = format!(
+        r#"{{
   "asset": {{"version": "2.0"}},
   "scene": 0,
   "scenes": [{{"nodes": [0, 1, 2]}}],
@@ -383,12 +379,23 @@ fn alpha_modes_cut_the_surface_out() {
     {{"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}}
   ]
 }}"#,
-            base64(&buffer)
-        );
-        let mut l = load(&text);
-        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
-        l.defaults.width = 32;
-        l.defaults.height = 32;
+        base64(&buffer)
+    );
+    let mut l = load(&text);
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    l.defaults.width = 32;
+    l.defaults.height = 32;
+    l
+}
+
+#[test]
+fn alpha_modes_cut_the_surface_out() {
+    // The lamp shows where the front square is cut away.
+    // Alpha 0 in the image's top-left and bottom-right texels, 255 in the others.
+    let texels = [0u8, 0, 0, 0, 9, 9, 9, 255, 9, 9, 9, 255, 0, 0, 0, 0];
+    let png = png(2, 2, 4, &texels);
+    let picture = |front: &str, spp: u32| {
+        let l = textured_square(front, &png);
         draw(&l, &path_settings(&l, spp, ColorMode::Rgb, 3))
     };
     // Black and metallic: the square reflects nothing.
@@ -427,4 +434,44 @@ fn alpha_modes_cut_the_surface_out() {
     );
     let mean = image.iter().map(|p| p[1] as f64).sum::<f64>() / image.len() as f64;
     assert!((mean - 0.875).abs() < 5.0 * 0.0024, "mean {mean}");
+}
+
+#[test]
+fn the_metallic_roughness_texture_varies_both() {
+    // Green is roughness, blue metallic, stored linearly (not sRGB), times the factors
+    // (roughness 0.5, metallic 1). Texels from the image's top-left: (rough 1, metal 0),
+    // (rough 0, metal 1), (rough 0.2, metal 0.6), (rough 0.6, metal 0.2).
+    let texels = [0u8, 255, 0, 0, 0, 255, 0, 51, 153, 0, 153, 51];
+    let l = textured_square(
+        r#"{"pbrMetallicRoughness": {"roughnessFactor": 0.5, "metallicFactor": 1, "metallicRoughnessTexture": {"index": 0}}}"#,
+        &png(2, 2, 3, &texels),
+    );
+    use plenum_core::material::{FloatTexture, Material};
+    use plenum_core::math::Vec3;
+    use plenum_core::texture::TextureCoords;
+    let m = &l.scene.materials[l.scene.geometry.primitives[0].material as usize];
+    let Material::Mix { materials, amount } = m else {
+        panic!("expected a mix of dielectric and metal: {m:?}");
+    };
+    let Material::Conductor(metal) = &l.scene.materials[materials[1] as usize] else {
+        panic!("expected the metal second");
+    };
+    // Plenum's (u, v) has v up: the image's top-left texel is at (0.25, 0.75).
+    let at = |u: f64, v: f64| TextureCoords {
+        uv: [u, v],
+        object_point: Vec3::ZERO,
+    };
+    for ((u, v), rough, metallic) in [
+        ((0.25, 0.75), 1.0, 0.0),
+        ((0.75, 0.75), 0.0, 1.0),
+        ((0.25, 0.25), 0.2, 0.6),
+        ((0.75, 0.25), 0.6, 0.2),
+    ] {
+        let a = metal.roughness.u.evaluate(&at(u, v));
+        let want = (rough * 0.5f64).powi(2);
+        assert!((a - want).abs() < 1e-6, "({u}, {v}): α {a}, want {want}");
+        let k = amount.evaluate(&at(u, v));
+        assert!((k - metallic).abs() < 1e-6, "({u}, {v}): metallic {k}");
+    }
+    assert!(matches!(metal.roughness.v, FloatTexture::Texture(_)));
 }
