@@ -91,6 +91,9 @@ pub struct ImageTexture {
     texels: Vec<Color>,
     /// Repeats of the image per unit of u and v.
     pub scale: [f64; 2],
+    /// An affine map of (u, v) applied before `scale` (rows: u′ = m[0]·(u, v, 1), v′ =
+    /// m[1]·(u, v, 1)): an atlas's region, turned (glTF's `KHR_texture_transform`).
+    uv_transform: Option<Box<[[f64; 3]; 2]>>,
 }
 
 impl ImageTexture {
@@ -101,7 +104,15 @@ impl ImageTexture {
             height,
             texels,
             scale,
+            uv_transform: None,
         })
+    }
+
+    /// The image looked up at (u, v) mapped by the affine `m` first (see `uv_transform`).
+    pub fn with_uv_transform(mut self, m: [[f64; 3]; 2]) -> Self {
+        let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        self.uv_transform = (m != identity).then(|| Box::new(m));
+        self
     }
 
     /// The mean of all texels.
@@ -118,6 +129,13 @@ impl ImageTexture {
 
     /// Bilinear interpolation between the four nearest texel centres, wrapping at the edges.
     pub fn bilinear(&self, uv: [f64; 2]) -> Color {
+        let uv = match &self.uv_transform {
+            None => uv,
+            Some(m) => [
+                m[0][0] * uv[0] + m[0][1] * uv[1] + m[0][2],
+                m[1][0] * uv[0] + m[1][1] * uv[1] + m[1][2],
+            ],
+        };
         let x = uv[0] * self.scale[0] * self.width as f64 - 0.5;
         let y = (1.0 - uv[1] * self.scale[1]) * self.height as f64 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());

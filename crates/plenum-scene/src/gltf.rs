@@ -156,6 +156,13 @@ struct Reader<'a> {
     lights: usize,
 }
 
+/// A texture's image decoded, where it came from, and the uv transform its textureInfo gives.
+struct Decoded {
+    texels: plenum_image::Texels,
+    at: String,
+    uv_transform: Option<[[f64; 3]; 2]>,
+}
+
 /// What a glTF material becomes: Plenum's material, the emission, the cut-out.
 #[derive(Clone)]
 struct Surface {
@@ -419,18 +426,29 @@ impl<'a> Reader<'a> {
         colour: bool,
         base: &Path,
         at: &str,
-    ) -> Result<(plenum_image::Texels, String)> {
-        if info.tex_coord() != 0 {
+    ) -> Result<Decoded> {
+        let transform = info.texture_transform();
+        let set = transform
+            .as_ref()
+            .and_then(|t| t.tex_coord())
+            .unwrap_or(info.tex_coord());
+        if set != 0 {
             self.warn(format!(
-                "{at}: texture coordinates {} are not supported: using TEXCOORD_0",
-                info.tex_coord()
+                "{at}: texture coordinates {set} are not supported: using TEXCOORD_0"
             ));
         }
-        if info.texture_transform().is_some() {
-            self.warn(format!(
-                "{at}: KHR_texture_transform is not supported: ignored"
-            ));
-        }
+        let uv_transform = transform.map(|t| {
+            // KHR_texture_transform: uv′ = offset + R·(scale ∘ uv) in glTF's (u, v), v down,
+            // R turning (u, v) by −rotation as (c, s; −s, c) (the spec's own example, the
+            // lower-left quadrant for rotation π/2, scale ½, offset (0, 1), fixes the sign).
+            let ([ox, oy], r, [sx, sy]) = (t.offset(), t.rotation() as f64, t.scale());
+            let (s, c) = r.sin_cos();
+            let (a, b, c0) = (c * sx as f64, s * sy as f64, ox as f64);
+            let (d, e, f) = (-s * sx as f64, c * sy as f64, oy as f64);
+            // In Plenum's (u, v), v = 1 − glTF's, and the image is looked up with v up: u′ =
+            // a·u + b·(1 − v) + c0, v′ = 1 − (d·u + e·(1 − v) + f).
+            [[a, -b, b + c0], [-d, e, 1.0 - e - f]]
+        });
         let sampler = info.texture().sampler();
         if sampler.wrap_s() != gltf::texture::WrappingMode::Repeat
             || sampler.wrap_t() != gltf::texture::WrappingMode::Repeat
@@ -463,31 +481,28 @@ impl<'a> Reader<'a> {
             }
         }
         .map_err(|e| self.error(&iat, e))?;
-        Ok((texels, iat))
+        Ok(Decoded {
+            texels,
+            at: iat,
+            uv_transform,
+        })
     }
 
-    /// An image texture of `texels` mapped by `value` (a texel's RGB and alpha to a colour);
-    /// `iat` names the image.
-    fn image_texture(
-        &self,
-        texels: &plenum_image::Texels,
-        iat: &str,
-        value: impl Fn(usize) -> Color,
-    ) -> Result<Texture> {
-        let colors = (0..texels.rgb.len()).map(value).collect();
-        let image = ImageTexture::new(texels.width, texels.height, colors, [1.0, 1.0])
-            .ok_or_else(|| self.error(iat, "the image is empty"))?;
+    /// An image texture of `d`'s texels mapped by `value` (a texel's index to a colour).
+    fn image_texture(&self, d: &Decoded, value: impl Fn(usize) -> Color) -> Result<Texture> {
+        let colors = (0..d.texels.rgb.len()).map(value).collect();
+        let mut image = ImageTexture::new(d.texels.width, d.texels.height, colors, [1.0, 1.0])
+            .ok_or_else(|| self.error(&d.at, "the image is empty"))?;
+        if let Some(m) = d.uv_transform {
+            image = image.with_uv_transform(m);
+        }
         Ok(Texture::Image(Arc::new(image)))
     }
 
     /// The material's cut-out (none for `OPAQUE`): the base colour's alpha, its factor times
     /// its texture's alpha channel, compared with `alphaCutoff` under `MASK`; under `BLEND`,
     /// a coverage, which the surface has stochastically (blending averaged over samples).
-    fn alpha(
-        &self,
-        m: &gltf::Material,
-        base_texels: Option<&(plenum_image::Texels, String)>,
-    ) -> Result<Option<Alpha>> {
+    fn alpha(&self, m: &gltf::Material, base_texels: Option<&Decoded>) -> Result<Option<Alpha>> {
         let cutoff = match m.alpha_mode() {
             gltf::material::AlphaMode::Opaque => return Ok(None),
             gltf::material::AlphaMode::Mask => Some(m.alpha_cutoff().unwrap_or(0.5) as f64),
@@ -495,10 +510,10 @@ impl<'a> Reader<'a> {
         };
         let factor = m.pbr_metallic_roughness().base_color_factor()[3] as f64;
         let texture = match base_texels {
-            Some((t, iat)) if t.alpha.is_some() => {
-                let alpha = t.alpha.as_deref().unwrap_or_default();
+            Some(d) if d.texels.alpha.is_some() => {
+                let alpha = d.texels.alpha.as_deref().unwrap_or_default();
                 FloatTexture::Texture(
-                    self.image_texture(t, iat, |i| Color::gray(alpha[i] as f64 * factor))?,
+                    self.image_texture(d, |i| Color::gray(alpha[i] as f64 * factor))?,
                 )
             }
             _ => FloatTexture::Constant(factor),
@@ -527,9 +542,9 @@ impl<'a> Reader<'a> {
             None => None,
         };
         let base_color = match &base_texels {
-            Some((t, iat)) => SpectralTexture::from_texture(
-                self.image_texture(t, iat, |i| {
-                    let p = t.rgb[i];
+            Some(d) => SpectralTexture::from_texture(
+                self.image_texture(d, |i| {
+                    let p = d.texels.rgb[i];
                     Color::new(p[0] as f64 * r, p[1] as f64 * g, p[2] as f64 * b)
                 })?,
                 SpectrumKind::Albedo,
@@ -543,23 +558,18 @@ impl<'a> Reader<'a> {
         let (alpha, metallic) = match pbr.metallic_roughness_texture() {
             Some(info) => {
                 let what = format!("{at}.metallicRoughnessTexture");
-                let (t, iat) = self.texels(&info, false, base, &what)?;
-                let channel = |c: usize, factor: f64| {
-                    self.image_texture(&t, &iat, |i| {
-                        Color::gray((t.rgb[i][c] as f64).clamp(0.0, 1.0) * factor)
-                    })
-                };
+                let d = self.texels(&info, false, base, &what)?;
+                let texel = |i: usize, c: usize| (d.texels.rgb[i][c] as f64).clamp(0.0, 1.0);
                 // α = roughness², per texel.
-                let alpha = self.image_texture(&t, &iat, |i| {
-                    Color::gray(((t.rgb[i][1] as f64).clamp(0.0, 1.0) * rough_factor).powi(2))
-                })?;
-                (
-                    FloatTexture::Texture(alpha),
-                    match metal_factor {
-                        0.0 => FloatTexture::Constant(0.0),
-                        _ => FloatTexture::Texture(channel(2, metal_factor)?),
-                    },
-                )
+                let alpha =
+                    self.image_texture(&d, |i| Color::gray((texel(i, 1) * rough_factor).powi(2)))?;
+                let metallic = match metal_factor {
+                    0.0 => FloatTexture::Constant(0.0),
+                    _ => FloatTexture::Texture(
+                        self.image_texture(&d, |i| Color::gray(texel(i, 2) * metal_factor))?,
+                    ),
+                };
+                (FloatTexture::Texture(alpha), metallic)
             }
             None => (
                 FloatTexture::Constant(rough_factor.powi(2)),

@@ -475,3 +475,66 @@ fn the_metallic_roughness_texture_varies_both() {
     }
     assert!(matches!(metal.roughness.v, FloatTexture::Texture(_)));
 }
+
+#[test]
+fn texture_transforms_map_the_uvs_as_the_extensions_examples_say() {
+    // An 8 × 8 image of four quadrants: red top-left, green top-right, blue bottom-left,
+    // white bottom-right.
+    let mut texels = Vec::new();
+    for y in 0..8 {
+        for x in 0..8 {
+            texels.extend(match (x < 4, y < 4) {
+                (true, true) => [255, 0, 0],
+                (false, true) => [0, 255, 0],
+                (true, false) => [0, 0, 255],
+                (false, false) => [255, 255, 255],
+            });
+        }
+    }
+    let image = png(8, 8, 3, &texels);
+    let base_colour = |transform: &str| {
+        let l = textured_square(
+            &format!(
+                r#"{{"pbrMetallicRoughness": {{"metallicFactor": 1, "baseColorTexture": {{"index": 0{transform}}}}}}}"#
+            ),
+            &image,
+        );
+        use plenum_core::material::{ConductorSpec, Material};
+        let m = &l.scene.materials[l.scene.geometry.primitives[0].material as usize];
+        let Material::Conductor(c) = m else {
+            panic!("{m:?}")
+        };
+        let ConductorSpec::Reflectance(r) = &c.spec else {
+            panic!("{c:?}")
+        };
+        r.clone()
+    };
+    use plenum_core::math::Vec3;
+    use plenum_core::texture::TextureCoords;
+    // Plenum's (u, v), v up: (0.3, 0.7) is glTF's (0.3, 0.3), in the top-left quadrant.
+    let at = |u: f64, v: f64| TextureCoords {
+        uv: [u, v],
+        object_point: Vec3::ZERO,
+    };
+    let rgb = |t: &plenum_core::material::SpectralTexture, u, v| {
+        let c = t.rgb(&at(u, v));
+        [c.r, c.g, c.b].map(|x| (x * 100.0).round() / 100.0)
+    };
+    let plain = base_colour("");
+    assert_eq!(rgb(&plain, 0.3, 0.7), [1.0, 0.0, 0.0]);
+    assert_eq!(rgb(&plain, 0.7, 0.3), [1.0, 1.0, 1.0]);
+    // "This example utilizes only the lower left quadrant of the source image, rotated
+    // clockwise 90°": blue everywhere inside (away from the quadrant's blended edges).
+    let quadrant = base_colour(
+        r#", "extensions": {"KHR_texture_transform": {"offset": [0, 1], "rotation": 1.57079632679, "scale": [0.5, 0.5]}}"#,
+    );
+    for (u, v) in [(0.2, 0.2), (0.8, 0.2), (0.5, 0.5), (0.2, 0.8), (0.8, 0.8)] {
+        assert_eq!(rgb(&quadrant, u, v), [0.0, 0.0, 1.0], "({u}, {v})");
+    }
+    // "This example inverts the T axis": the top-left of the square shows the bottom-left.
+    let flipped = base_colour(
+        r#", "extensions": {"KHR_texture_transform": {"offset": [0, 1], "scale": [1, -1]}}"#,
+    );
+    assert_eq!(rgb(&flipped, 0.3, 0.7), [0.0, 0.0, 1.0]);
+    assert_eq!(rgb(&flipped, 0.7, 0.3), [0.0, 1.0, 0.0]);
+}
