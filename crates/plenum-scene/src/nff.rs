@@ -213,6 +213,7 @@ fn cone(base: Vec3, r0: f64, apex: Vec3, r1: f64) -> Option<(Shape, Transform)> 
         height,
         capped: false,
         inside_only: r0 < 0.0 && r1 < 0.0,
+        partial: None,
     });
     Some((shape, frame))
 }

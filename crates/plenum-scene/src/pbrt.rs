@@ -11,7 +11,7 @@ use crate::limits::MAX_NESTING;
 use crate::RenderDefaults;
 use plenum_core::camera::{CameraSettings, Lens};
 use plenum_core::color::Color;
-use plenum_core::geometry::{Cylinder, Disk, Shape, Sphere, TriangleMesh};
+use plenum_core::geometry::{Cylinder, Disk, Partial, Shape, Sphere, TriangleMesh};
 use plenum_core::integrator::IntegratorKind;
 use plenum_core::light::{Attenuation, Light};
 use plenum_core::material::{
@@ -1992,47 +1992,86 @@ impl Parser {
         let area = self.state.area_light.clone();
         // The side a one-sided area light emits from follows ReverseOrientation.
         let reverse = self.state.reverse_orientation && area.as_ref().is_some_and(|a| !a.two_sided);
-        let partial = |s: &mut Self, key: &str, full: f64| -> Result<()> {
-            if p.get(key).is_some() && s.float(p, key, full)? != full {
-                let l = p.get(key).unwrap().loc.clone();
+        // A partial quadric (pbrt-v4's zmin, zmax, innerradius, phimax): what it keeps. An
+        // area light is sampled over its whole shape, so a light stays whole.
+        let emits = area.is_some();
+        let cut = |s: &mut Self, keys: &[&str], partial: Partial| -> Option<Partial> {
+            let cut = partial.cut()?;
+            if emits {
+                let l = keys
+                    .iter()
+                    .find_map(|k| p.get(k))
+                    .map_or_else(|| loc.clone(), |q| q.loc.clone());
                 s.warn(
                     &l,
-                    format!("`{key}`: partial shapes are not supported: the whole shape"),
+                    "a partial shape cannot be an area light: the whole shape emits",
                 );
+                return None;
             }
-            Ok(())
+            Some(cut)
+        };
+        let phi_max = |s: &Self| -> Result<f64> {
+            let degrees = s.float(p, "phimax", 360.0)?.clamp(0.0, 360.0);
+            Ok(if degrees >= 360.0 {
+                std::f64::consts::TAU
+            } else {
+                degrees.to_radians()
+            })
         };
         let mut frame = Transform::IDENTITY;
         let shape = match ty {
             "sphere" => {
                 let r = self.positive(p, "radius", 1.0)?;
-                partial(self, "zmin", -r)?;
-                partial(self, "zmax", r)?;
-                partial(self, "phimax", 360.0)?;
+                let (z0, z1) = (self.float(p, "zmin", -r)?, self.float(p, "zmax", r)?);
+                let (z0, z1) = (z0.min(z1).clamp(-r, r), z0.max(z1).clamp(-r, r));
+                let partial = Partial {
+                    z_min: if z0 > -r { z0 } else { f64::NEG_INFINITY },
+                    z_max: if z1 < r { z1 } else { f64::INFINITY },
+                    phi_max: phi_max(self)?,
+                    ..Partial::WHOLE
+                };
                 if reverse {
                     self.warn(loc, "ReverseOrientation on a one-sided sphere light is not supported: it emits outward");
                 }
-                Shape::Sphere(Sphere::new(Vec3::ZERO, r))
+                let sphere = Sphere::new(Vec3::ZERO, r);
+                match cut(self, &["zmin", "zmax", "phimax"], partial) {
+                    Some(c) => Shape::Sphere(sphere.with_partial(c)),
+                    None => Shape::Sphere(sphere),
+                }
             }
             "disk" => {
                 let h = self.float(p, "height", 0.0)?;
                 let r = self.positive(p, "radius", 1.0)?;
-                partial(self, "innerradius", 0.0)?;
-                partial(self, "phimax", 360.0)?;
+                let partial = Partial {
+                    inner_radius: self.float(p, "innerradius", 0.0)?.max(0.0),
+                    phi_max: phi_max(self)?,
+                    ..Partial::WHOLE
+                };
                 let n = if reverse { -Vec3::Z } else { Vec3::Z };
-                Shape::Disk(Disk::new(Vec3::new(0.0, 0.0, h), n, r))
+                let disk = Disk::new(Vec3::new(0.0, 0.0, h), n, r);
+                match cut(self, &["innerradius", "phimax"], partial) {
+                    Some(c) => Shape::Disk(disk.with_partial(c)),
+                    None => Shape::Disk(disk),
+                }
             }
             "cylinder" => {
                 let r = self.positive(p, "radius", 1.0)?;
                 let (z0, z1) = (self.float(p, "zmin", -1.0)?, self.float(p, "zmax", 1.0)?);
-                partial(self, "phimax", 360.0)?;
                 if z1 <= z0 {
                     return Err(
                         self.error(loc, format!("expected zmax > zmin, found {z1} and {z0}"))
                     );
                 }
+                let partial = Partial {
+                    phi_max: phi_max(self)?,
+                    ..Partial::WHOLE
+                };
                 frame = Transform::translate(Vec3::new(0.0, 0.0, z0));
-                Shape::Cylinder(Cylinder::new(r, z1 - z0, false))
+                let cylinder = Cylinder::new(r, z1 - z0, false);
+                match cut(self, &["phimax"], partial) {
+                    Some(c) => Shape::Cylinder(cylinder.with_partial(c)),
+                    None => Shape::Cylinder(cylinder),
+                }
             }
             "trianglemesh" => Shape::Mesh(Arc::new(self.mesh(p, loc, 3, reverse)?)),
             "bilinearmesh" => Shape::Mesh(Arc::new(self.mesh(p, loc, 4, reverse)?)),

@@ -348,15 +348,15 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
             ),
         };
         let _ = match &p.shape {
-            Shape::Sphere(s) => writeln!(w, "type = \"sphere\"\ncenter = {}\nradius = {:?}\ninside_only = {}", vec(s.center), s.radius, s.inside_only),
+            Shape::Sphere(s) => writeln!(w, "type = \"sphere\"\ncenter = {}\nradius = {:?}\ninside_only = {}{}", vec(s.center), s.radius, s.inside_only, partial(s.partial)),
             Shape::Plane(s) => writeln!(w, "type = \"plane\"\npoint = {}\nnormal = {}", vec(s.point), vec(s.normal)),
-            Shape::Disk(s) => writeln!(w, "type = \"disk\"\ncenter = {}\nnormal = {}\nradius = {:?}", vec(s.center), vec(s.normal), s.radius),
+            Shape::Disk(s) => writeln!(w, "type = \"disk\"\ncenter = {}\nnormal = {}\nradius = {:?}{}", vec(s.center), vec(s.normal), s.radius, partial(s.partial)),
             Shape::Cuboid(s) => writeln!(w, "type = \"box\"\nmin = {}\nmax = {}", vec(s.min), vec(s.max)),
-            Shape::Cylinder(s) => writeln!(w, "type = \"cylinder\"\nbase = [0.0, 0.0, 0.0]\ntop = [0.0, 0.0, {:?}]\nradius = {:?}\ncapped = {}", s.height(), s.radius(), s.is_capped()),
+            Shape::Cylinder(s) => writeln!(w, "type = \"cylinder\"\nbase = [0.0, 0.0, 0.0]\ntop = [0.0, 0.0, {:?}]\nradius = {:?}\ncapped = {}{}", s.height(), s.radius(), s.is_capped(), partial(s.partial())),
             Shape::Cone(s) => writeln!(
                 w,
-                "type = \"cone\"\nbase = [0.0, 0.0, 0.0]\ntop = [0.0, 0.0, {:?}]\nradius = {:?}\ntop_radius = {:?}\ncapped = {}\ninside_only = {}",
-                s.height, s.radius0, s.radius1, s.capped, s.inside_only
+                "type = \"cone\"\nbase = [0.0, 0.0, 0.0]\ntop = [0.0, 0.0, {:?}]\nradius = {:?}\ntop_radius = {:?}\ncapped = {}\ninside_only = {}{}",
+                s.height, s.radius0, s.radius1, s.capped, s.inside_only, partial(s.partial)
             ),
             Shape::Polygon(s) => writeln!(w, "type = \"polygon\"\nvertices = {}", points(s.vertices())),
             Shape::Polyhedron(s) => {
@@ -576,6 +576,27 @@ fn emission(scene: &Scene, light: usize, rgb: Color, key: &str) -> String {
         let key = if key == "color" { "spectrum" } else { key };
         format!("{key} = {}", spectrum(s))
     }
+}
+
+/// A partial shape's cut as native keys, each on a line of its own after a newline.
+fn partial(p: Option<plenum_core::geometry::Partial>) -> String {
+    let Some(p) = p else {
+        return String::new();
+    };
+    let mut out = String::new();
+    if p.z_min > f64::NEG_INFINITY {
+        let _ = write!(out, "\nz_min = {:?}", p.z_min);
+    }
+    if p.z_max < f64::INFINITY {
+        let _ = write!(out, "\nz_max = {:?}", p.z_max);
+    }
+    if p.inner_radius > 0.0 {
+        let _ = write!(out, "\ninner_radius = {:?}", p.inner_radius);
+    }
+    if p.phi_max < std::f64::consts::TAU {
+        let _ = write!(out, "\nphi_max = {:?}", p.phi_max.to_degrees());
+    }
+    out
 }
 
 fn vec(v: Vec3) -> String {

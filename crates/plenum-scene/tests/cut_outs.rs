@@ -1,5 +1,6 @@
-//! Cut-outs in the native format: `alpha` (a number or a texture, an image's alpha channel
-//! among them) and `alpha_cutoff` on objects, their located errors, and `plenum convert`
+//! Cut-outs and partial shapes in the native format: `alpha` (a number or a texture, an
+//! image's alpha channel among them) and `alpha_cutoff` on objects; `z_min`, `z_max`,
+//! `inner_radius` and `phi_max` on quadrics; their located errors, and `plenum convert`
 //! writing them back.
 
 mod common;
@@ -128,4 +129,94 @@ fn bad_alphas_are_located_errors() {
     let e = error(&scene("").replace("emission = 1.0", "emission = 1.0\nalpha = 0.5"));
     let s = e.to_string();
     assert!(s.contains(":16:") && s.contains("cannot be cut out"), "{s}");
+}
+
+/// A scene of one object after the lamp and material of [`scene`].
+fn one(object: &str) -> String {
+    format!(
+        "[materials.grey]\ntype = \"diffuse\"\n\n[[lights]]\ntype = \"point\"\nposition = [0, 5, 5]\n\n[[objects]]\nmaterial = \"grey\"\n{object}\n"
+    )
+}
+
+#[test]
+fn partial_quadrics_read_render_and_convert() {
+    use plenum_core::geometry::Shape;
+    let text = one("type = \"sphere\"\nradius = 2\nz_min = -1\nz_max = 1.5\nphi_max = 90");
+    let l = load_files(&[("scene.toml", text.as_bytes())]).unwrap();
+    let Shape::Sphere(s) = &l.scene.geometry.primitives[0].shape else {
+        panic!()
+    };
+    let p = s.partial.unwrap();
+    assert_eq!((p.z_min, p.z_max), (-1.0, 1.5));
+    assert!((p.phi_max - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    let written = plenum_scene::to_toml(&l.scene, &l.defaults);
+    for key in ["z_min = -1.0", "z_max = 1.5", "phi_max = 90.0"] {
+        assert!(written.contains(key), "{key} in {written}");
+    }
+    let text =
+        one("type = \"disk\"\nnormal = [0, 0, 1]\nradius = 2\ninner_radius = 0.5\nphi_max = 270");
+    let l = load_files(&[("scene.toml", text.as_bytes())]).unwrap();
+    let Shape::Disk(d) = &l.scene.geometry.primitives[0].shape else {
+        panic!()
+    };
+    assert_eq!(d.partial.unwrap().inner_radius, 0.5);
+    let written = plenum_scene::to_toml(&l.scene, &l.defaults);
+    assert!(
+        written.contains("inner_radius = 0.5") && written.contains("phi_max = 270"),
+        "{written}"
+    );
+    for kind in ["cylinder", "cone"] {
+        let text = one(&format!(
+            "type = \"{kind}\"\ntop = [0, 0, 1]\nradius = 1\nphi_max = 180"
+        ));
+        let l = load_files(&[("scene.toml", text.as_bytes())]).unwrap();
+        let shape = &l.scene.geometry.primitives[0].shape;
+        assert!(!shape.is_closed(), "a swept {kind} is open");
+        let written = plenum_scene::to_toml(&l.scene, &l.defaults);
+        assert!(written.contains("phi_max = 180.0"), "{written}");
+    }
+    // 360 is the whole turn: nothing is cut, and a closed sphere stays closed.
+    let text = one("type = \"sphere\"\nradius = 1\nphi_max = 360");
+    let l = load_files(&[("scene.toml", text.as_bytes())]).unwrap();
+    assert!(l.scene.geometry.primitives[0].shape.is_closed());
+}
+
+#[test]
+fn bad_cuts_are_located_errors() {
+    let error = |object: &str| match load_files(&[("scene.toml", one(object).as_bytes())]) {
+        Ok(_) => panic!("expected an error for {object}"),
+        Err(e) => e.to_string(),
+    };
+    // The object's keys start on line 10; each error points at the key that is wrong.
+    for (object, what, line) in [
+        (
+            "type = \"sphere\"\nradius = 1\nphi_max = 0",
+            "phi_max in (0, 360]",
+            12,
+        ),
+        (
+            "type = \"sphere\"\nradius = 1\nphi_max = 400",
+            "phi_max in (0, 360]",
+            12,
+        ),
+        (
+            "type = \"sphere\"\nradius = 1\nz_min = 0.5\nz_max = 0.2",
+            "z_max > z_min",
+            13,
+        ),
+        (
+            "type = \"disk\"\nnormal = [0, 0, 1]\nradius = 1\ninner_radius = 1",
+            "inner_radius below",
+            13,
+        ),
+        (
+            "type = \"sphere\"\nradius = 1\nemission = 1.0\nphi_max = 90",
+            "cannot be partial",
+            13,
+        ),
+    ] {
+        let e = error(object);
+        let at = format!("scene.toml:{line}:");
+        assert!(e.contains(what) && e.contains(&at), "{object}: {e}");
+    }
 }

@@ -630,3 +630,70 @@ Shape "trianglemesh" "point3 P" [ -5 -5 2  5 -5 2  5 5 2  -5 5 2 ]
     let image = picture(r#""float alpha" 1"#, 1);
     assert!(image.iter().all(|p| p[1] == 0.0));
 }
+
+#[test]
+fn partial_quadrics_keep_what_pbrt_keeps() {
+    // A black disk filling the view in front of a lamp of L = 1: swept through 180° it hides
+    // the top half only (φ from +x toward +y, pbrt's +y up in the image); with an inner
+    // radius the lamp shows through the hole.
+    let picture = |disk: &str| {
+        let l = load(&format!(
+            r#"{VIEW}AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 1 1 1 ]
+  Translate 0 0 3
+  Shape "bilinearmesh" "point3 P" [ -5 -5 0  -5 5 0  5 -5 0  5 5 0 ] "integer indices" [ 0 1 2 3 ]
+AttributeEnd
+Material "diffuse" "rgb reflectance" [ 0 0 0 ]
+AttributeBegin
+  Translate 0 0 2
+  Shape "disk" "float radius" 5 {disk}
+AttributeEnd
+"#
+        ));
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        draw(&l, &path_settings(&l, 1, ColorMode::Rgb, 3))
+    };
+    let lamp = |image: &[[f32; 3]], x: usize, y: usize| image[y * 32 + x][1] > 0.5;
+    let half = picture(r#""float phimax" 180"#);
+    assert!(!lamp(&half, 16, 6) && lamp(&half, 16, 26));
+    let ring = picture(r#""float innerradius" 0.5"#);
+    assert!(lamp(&ring, 16, 16) && !lamp(&ring, 2, 2));
+    // The shapes carry their cuts: a dome (zmin 0) and a half cylinder.
+    let l = load(&format!(
+        r#"{VIEW}LightSource "point" "rgb I" [ 1 1 1 ]
+Shape "sphere" "float radius" 2 "float zmin" 0 "float zmax" 5
+Shape "cylinder" "float phimax" 180
+"#
+    ));
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    use plenum_core::geometry::Shape;
+    let shapes: Vec<&Shape> = l
+        .scene
+        .geometry
+        .primitives
+        .iter()
+        .map(|p| &p.shape)
+        .collect();
+    let Shape::Sphere(s) = shapes[0] else {
+        panic!("{:?}", shapes[0])
+    };
+    let cut = s.partial.unwrap();
+    assert_eq!((cut.z_min, cut.z_max), (0.0, f64::INFINITY));
+    let Shape::Cylinder(c) = shapes[1] else {
+        panic!("{:?}", shapes[1])
+    };
+    assert!((c.partial().unwrap().phi_max - std::f64::consts::PI).abs() < 1e-12);
+    // An area light stays whole, said where the cut is written.
+    let l = load(&format!(
+        r#"{VIEW}AreaLightSource "diffuse" "rgb L" [ 1 1 1 ]
+Shape "sphere" "float phimax" 90
+"#
+    ));
+    assert!(
+        l.warnings.len() == 1
+            && l.warnings[0].contains("whole shape emits")
+            && l.warnings[0].contains(":7:"),
+        "{:?}",
+        l.warnings
+    );
+}

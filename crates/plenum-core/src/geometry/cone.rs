@@ -2,7 +2,7 @@
 //! radius going linearly from `radius0` to `radius1`, optionally closed by disk caps. The
 //! scene places them with a transform.
 
-use super::{nearest_root, HitRecord, SurfaceGeometry};
+use super::{nearest_root, HitRecord, Partial, SurfaceGeometry};
 use crate::math::{gamma, solve_quadratic, Bounds3, Ray, Vec3};
 use std::f64::consts::PI;
 
@@ -14,6 +14,8 @@ pub struct Cone {
     pub capped: bool,
     /// Only the inside of the side is visible (NFF's negative radii); for open cones.
     pub inside_only: bool,
+    /// What is kept of it, about the axis (none: all): a sector of less than a full turn.
+    pub partial: Option<Partial>,
 }
 
 const SIDE: u32 = 0;
@@ -50,7 +52,9 @@ impl Cone {
                 let n = Vec3::new(p.x, p.y, -k * self.radius_at(p.z));
                 n.dot(d) > 0.0
             };
-            (0.0..=self.height).contains(&p.z) && (!self.inside_only || facing_in())
+            (0.0..=self.height).contains(&p.z)
+                && (!self.inside_only || facing_in())
+                && self.partial.is_none_or(|c| c.keeps(p))
         };
         let mut best: Option<HitRecord> = nearest_root(solve_quadratic(a, b, c), t_max, in_height)
             .map(|t| HitRecord {
@@ -68,7 +72,8 @@ impl Cone {
                 let limit = best.map_or(t_max, |h| h.t);
                 if t > 0.0 && t < limit {
                     let (x, y) = (o.x + t * d.x, o.y + t * d.y);
-                    if x * x + y * y <= r * r {
+                    let kept = self.partial.is_none_or(|c| c.keeps(Vec3::new(x, y, z)));
+                    if x * x + y * y <= r * r && kept {
                         best = Some(HitRecord {
                             t,
                             u: 0.0,
@@ -144,6 +149,7 @@ mod tests {
             height: 1.0,
             capped: false,
             inside_only: false,
+            partial: None,
         };
         let ray = Ray::new(Vec3::new(-5.0, 0.0, 0.5), Vec3::X);
         let hit = cone.intersect(&ray, 1e9).unwrap();
@@ -161,6 +167,7 @@ mod tests {
             height: 1.0,
             capped: false,
             inside_only: false,
+            partial: None,
         };
         let ray = Ray::new(Vec3::new(0.0, 0.0, 3.0), -Vec3::Z);
         let hit = cone.intersect(&ray, 1e9).unwrap();
@@ -176,6 +183,7 @@ mod tests {
             height: 2.0,
             capped: false,
             inside_only: false,
+            partial: None,
         };
         let ray = Ray::new(Vec3::new(0.1, 0.0, 5.0), -Vec3::Z);
         // Open: the ray passes down the axis and leaves through the open bottom.

@@ -1,7 +1,7 @@
 //! Finite circular cylinders about the z axis from z = 0 to z = height, optionally capped:
 //! a cone whose two radii are equal.
 
-use super::{Cone, HitRecord, SurfaceGeometry};
+use super::{Cone, HitRecord, Partial, SurfaceGeometry};
 use crate::math::{Bounds3, Ray};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,8 +18,19 @@ impl Cylinder {
                 height,
                 capped,
                 inside_only: false,
+                partial: None,
             },
         }
+    }
+
+    /// The cylinder swept through less than a full turn, as `partial` keeps it.
+    pub fn with_partial(mut self, partial: Partial) -> Self {
+        self.shape.partial = partial.cut();
+        self
+    }
+
+    pub fn partial(&self) -> Option<Partial> {
+        self.shape.partial
     }
 
     pub fn radius(&self) -> f64 {
@@ -51,6 +62,24 @@ impl Cylinder {
 mod tests {
     use super::*;
     use crate::math::Vec3;
+
+    #[test]
+    fn half_a_cylinder_shows_its_inside_through_the_cut() {
+        // φ up to 180°: the half at y ≥ 0. A ray along +y from below passes the cut half and
+        // meets the inside of the kept one.
+        let c = Cylinder::new(1.0, 2.0, false).with_partial(Partial {
+            phi_max: std::f64::consts::PI,
+            ..Partial::WHOLE
+        });
+        let hit = c
+            .intersect(&Ray::new(Vec3::new(0.0, -5.0, 1.0), Vec3::Y), 1e9)
+            .unwrap();
+        assert!((hit.t - 6.0).abs() < 1e-12);
+        assert!(c
+            .intersect(&Ray::new(Vec3::new(5.0, -0.5, 1.0), -Vec3::X), 1e9)
+            .is_none());
+        assert!(!super::super::Shape::Cylinder(c).is_closed() && c.partial().is_some());
+    }
 
     #[test]
     fn side_and_inside_hits() {

@@ -1,6 +1,6 @@
 //! A flat disk: the points of a plane within `radius` of `center`.
 
-use super::{plane_distance, project_onto_plane, HitRecord, SurfaceGeometry};
+use super::{plane_distance, project_onto_plane, HitRecord, Partial, SurfaceGeometry};
 use crate::math::{Bounds3, Ray, Vec3};
 use std::f64::consts::PI;
 
@@ -12,6 +12,9 @@ pub struct Disk {
     pub radius: f64,
     tangent_s: Vec3,
     tangent_t: Vec3,
+    /// What is kept of it, in the scene's axes about `center` (pbrt-v4's disks lie in the
+    /// xy plane): a hole, a sector. None: all.
+    pub partial: Option<Partial>,
 }
 
 impl Disk {
@@ -24,6 +27,15 @@ impl Disk {
             radius,
             tangent_s,
             tangent_t,
+            partial: None,
+        }
+    }
+
+    /// The disk cut to what `partial` keeps.
+    pub fn with_partial(self, partial: Partial) -> Self {
+        Disk {
+            partial: partial.cut(),
+            ..self
         }
     }
 
@@ -41,7 +53,9 @@ impl Disk {
     pub fn intersect(&self, ray: &Ray, t_max: f64) -> Option<HitRecord> {
         let t = plane_distance(ray, self.normal, self.normal.dot(self.center), t_max)?;
         let d = ray.at(t) - self.center;
-        (d.length_squared() <= self.radius * self.radius).then_some(HitRecord {
+        let kept = d.length_squared() <= self.radius * self.radius
+            && self.partial.is_none_or(|p| p.keeps(d));
+        kept.then_some(HitRecord {
             t,
             u: 0.0,
             v: 0.0,
@@ -68,6 +82,23 @@ impl Disk {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_ring_and_a_sector_keep_what_they_say() {
+        let ring = Disk::new(Vec3::ZERO, Vec3::Z, 1.0).with_partial(Partial {
+            inner_radius: 0.5,
+            ..Partial::WHOLE
+        });
+        let at = |x: f64, y: f64| Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z);
+        assert!(ring.intersect(&at(0.3, 0.3), 9.0).is_none());
+        assert!(ring.intersect(&at(0.5, 0.5), 9.0).is_some());
+        let half = Disk::new(Vec3::ZERO, -Vec3::Z, 1.0).with_partial(Partial {
+            phi_max: PI,
+            ..Partial::WHOLE
+        });
+        assert!(half.intersect(&at(0.1, 0.5), 9.0).is_some());
+        assert!(half.intersect(&at(0.1, -0.5), 9.0).is_none());
+    }
 
     #[test]
     fn hits_inside_radius_only() {

@@ -15,6 +15,7 @@ mod cuboid;
 mod cylinder;
 mod disk;
 pub mod mesh;
+mod partial;
 mod plane;
 mod polygon;
 mod polyhedron;
@@ -25,6 +26,7 @@ pub use cuboid::Cuboid;
 pub use cylinder::Cylinder;
 pub use disk::Disk;
 pub use mesh::TriangleMesh;
+pub use partial::Partial;
 pub use plane::Plane;
 pub use polygon::{Polygon, PolygonError};
 pub use polyhedron::{Polyhedron, PolyhedronError};
@@ -147,9 +149,10 @@ impl Shape {
     /// half-space); thin sheets such as polygons, disks and open shells do not.
     pub fn is_closed(&self) -> bool {
         match self {
-            Shape::Sphere(_) | Shape::Plane(_) | Shape::Cuboid(_) | Shape::Polyhedron(_) => true,
-            Shape::Cylinder(s) => s.is_capped(),
-            Shape::Cone(s) => s.capped,
+            Shape::Sphere(s) => s.partial.is_none(),
+            Shape::Plane(_) | Shape::Cuboid(_) | Shape::Polyhedron(_) => true,
+            Shape::Cylinder(s) => s.is_capped() && s.partial().is_none(),
+            Shape::Cone(s) => s.capped && s.partial.is_none(),
             Shape::Disk(_) | Shape::Polygon(_) => false,
             Shape::Mesh(m) => m.is_closed(),
         }

@@ -2,7 +2,7 @@
 //! for ray/sphere intersection" (Ray Tracing Gems, ch. 7): the discriminant is computed from
 //! the ray's perpendicular offset to the centre, which stays accurate for far or huge spheres.
 
-use super::{nearest_root, HitRecord, SurfaceGeometry};
+use super::{nearest_root, HitRecord, Partial, SurfaceGeometry};
 use crate::math::{gamma, Bounds3, Ray, Vec3};
 use std::f64::consts::PI;
 
@@ -12,6 +12,8 @@ pub struct Sphere {
     pub radius: f64,
     /// Only the inside of the surface is visible (NFF's negative radius).
     pub inside_only: bool,
+    /// What is kept of it, about `center` (none: all).
+    pub partial: Option<Partial>,
 }
 
 impl Sphere {
@@ -20,13 +22,27 @@ impl Sphere {
             center,
             radius,
             inside_only: false,
+            partial: None,
+        }
+    }
+
+    /// The sphere cut to what `partial` keeps.
+    pub fn with_partial(self, partial: Partial) -> Self {
+        Sphere {
+            partial: partial.cut(),
+            ..self
         }
     }
 
     pub fn bounds(&self) -> Bounds3 {
+        let r = self.radius;
+        // A band between two heights is bounded by them.
+        let (z0, z1) = self.partial.map_or((-r, r), |p| {
+            (p.z_min.max(-r), p.z_max.min(r).max(p.z_min.max(-r)))
+        });
         Bounds3::new(
-            self.center - Vec3::splat(self.radius),
-            self.center + Vec3::splat(self.radius),
+            self.center + Vec3::new(-r, -r, z0),
+            self.center + Vec3::new(r, r, z1),
         )
     }
 
@@ -59,7 +75,11 @@ impl Sphere {
         } else {
             roots
         };
-        let t = nearest_root(roots, t_max, |_| true)?;
+        let kept = |t: f64| {
+            self.partial
+                .is_none_or(|p| p.keeps(ray.at(t) - self.center))
+        };
+        let t = nearest_root(roots, t_max, kept)?;
         Some(HitRecord {
             t,
             u: 0.0,
@@ -90,6 +110,7 @@ impl Sphere {
 #[cfg(test)]
 mod tests {
     use super::super::test_util::assert_close;
+    use super::super::Shape;
     use super::*;
 
     #[test]
@@ -101,6 +122,41 @@ mod tests {
         assert!((hit.t - (5.0 - 3f64.sqrt())).abs() < 1e-12);
         let g = s.surface(&ray, &hit, true);
         assert_close(g.n, Vec3::new(0.5, 0.0, -(3f64.sqrt()) / 2.0), 1e-12);
+    }
+
+    #[test]
+    fn a_cut_sphere_is_hit_where_it_is_kept_and_seen_inside_through_the_cut() {
+        // The upper half (z ≥ 0) of a unit sphere at (0, 0, 0).
+        let top = Sphere::new(Vec3::ZERO, 1.0).with_partial(Partial {
+            z_min: 0.0,
+            ..Partial::WHOLE
+        });
+        let up = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::Z);
+        // The near root (z = −1) is cut away: the inside of the dome at z = 1.
+        assert!((top.intersect(&up, 1e9).unwrap().t - 6.0).abs() < 1e-12);
+        let down = Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z);
+        assert!((top.intersect(&down, 1e9).unwrap().t - 4.0).abs() < 1e-12);
+        let b = top.bounds();
+        assert_eq!((b.min.z, b.max.z), (0.0, 1.0));
+        assert!(!Shape::Sphere(top).is_closed());
+        // A quarter turn (φ from +x toward +y up to 90°): at y = 0.5 the near side (φ = 150°)
+        // is cut, the far (φ = 30°) kept.
+        let quarter = Sphere::new(Vec3::ZERO, 1.0).with_partial(Partial {
+            phi_max: std::f64::consts::FRAC_PI_2,
+            ..Partial::WHOLE
+        });
+        let ray = Ray::new(Vec3::new(-5.0, 0.5, 0.0), Vec3::X);
+        let want = 5.0 + 0.75f64.sqrt();
+        assert!((quarter.intersect(&ray, 1e9).unwrap().t - want).abs() < 1e-12);
+        let ray = Ray::new(Vec3::new(-5.0, -0.5, 0.0), Vec3::X);
+        assert!(quarter.intersect(&ray, 1e9).is_none());
+        // Nothing cut: no partial kept.
+        assert_eq!(
+            Sphere::new(Vec3::ZERO, 1.0)
+                .with_partial(Partial::WHOLE)
+                .partial,
+            None
+        );
     }
 
     #[test]

@@ -6,7 +6,7 @@ use crate::diagnostics::did_you_mean;
 use crate::reader::{Fields, Result, Value};
 use crate::{obj, ply};
 use plenum_core::geometry::{
-    Cone, Cuboid, Cylinder, Disk, Plane, Polygon, Polyhedron, Shape, Sphere, TriangleMesh,
+    Cone, Cuboid, Cylinder, Disk, Partial, Plane, Polygon, Polyhedron, Shape, Sphere, TriangleMesh,
 };
 use plenum_core::material::{FloatTexture, PhongMaterial};
 use plenum_core::math::{Transform, Vec3};
@@ -29,11 +29,18 @@ impl<'s> Reader<'s> {
         ];
         let kind = self.kind(v, "an object", KINDS)?;
         let fields: &[&'static str] = match kind.as_str() {
-            "sphere" => &["center", "radius", "inside_only"],
+            "sphere" => &[
+                "center",
+                "radius",
+                "inside_only",
+                "z_min",
+                "z_max",
+                "phi_max",
+            ],
             "plane" => &["point", "normal"],
-            "disk" => &["center", "normal", "radius"],
+            "disk" => &["center", "normal", "radius", "inner_radius", "phi_max"],
             "box" => &["min", "max"],
-            "cylinder" => &["base", "top", "radius", "capped"],
+            "cylinder" => &["base", "top", "radius", "capped", "phi_max"],
             "cone" => &[
                 "base",
                 "top",
@@ -41,6 +48,7 @@ impl<'s> Reader<'s> {
                 "top_radius",
                 "capped",
                 "inside_only",
+                "phi_max",
             ],
             "polygon" => &["vertices"],
             "polyhedron" => &["vertices", "faces"],
@@ -78,6 +86,16 @@ impl<'s> Reader<'s> {
         };
         let alpha = self.alpha(&f)?;
         if let Some(e) = f.get("emission") {
+            // An area light is sampled over its whole shape.
+            if let Some(k) = ["z_min", "z_max", "inner_radius", "phi_max"]
+                .iter()
+                .find_map(|k| f.get(k))
+            {
+                return Err(self.src.error(
+                    k.span(),
+                    "an emitting object cannot be partial: drop the cut",
+                ));
+            }
             if let Some(a) = f.get("alpha") {
                 return Err(self.src.error(
                     a.span(),
@@ -216,8 +234,24 @@ impl<'s> Reader<'s> {
     }
 
     /// The shape in its own coordinates and the frame that places it (identity for most).
+    /// `phi_max` (degrees in (0, 360]) sweeps a sphere, disk, cylinder or cone through less
+    /// than a turn.
     fn shape(&mut self, kind: &str, f: &Fields<'_, 's>) -> Result<(Shape, Transform)> {
         let src = self.src;
+        let phi_max = |f: &Fields<'_, 's>| -> Result<f64> {
+            let degrees = f.number_or("phi_max", 360.0)?;
+            if !(degrees > 0.0 && degrees <= 360.0) {
+                return Err(src.error(
+                    f.required("phi_max")?.span(),
+                    format!("expected phi_max in (0, 360] degrees, found {degrees}"),
+                ));
+            }
+            Ok(if degrees >= 360.0 {
+                std::f64::consts::TAU
+            } else {
+                degrees.to_radians()
+            })
+        };
         let shape = match kind {
             "sphere" => {
                 let mut sphere = Sphere::new(
@@ -225,17 +259,47 @@ impl<'s> Reader<'s> {
                     f.positive("radius", None)?,
                 );
                 sphere.inside_only = f.bool_or("inside_only", false)?;
-                Shape::Sphere(sphere)
+                let (z_min, z_max) = (
+                    f.number_or("z_min", f64::NEG_INFINITY)?,
+                    f.number_or("z_max", f64::INFINITY)?,
+                );
+                if z_min >= z_max {
+                    return Err(src.error(
+                        f.required("z_max")?.span(),
+                        format!("expected z_max > z_min, found {z_max} and {z_min}"),
+                    ));
+                }
+                Shape::Sphere(sphere.with_partial(Partial {
+                    z_min,
+                    z_max,
+                    phi_max: phi_max(f)?,
+                    ..Partial::WHOLE
+                }))
             }
             "plane" => Shape::Plane(Plane::new(
                 f.vec3_or("point", Vec3::ZERO)?,
                 f.direction("normal", None)?,
             )),
-            "disk" => Shape::Disk(Disk::new(
-                f.vec3_or("center", Vec3::ZERO)?,
-                f.direction("normal", None)?,
-                f.positive("radius", None)?,
-            )),
+            "disk" => {
+                let radius = f.positive("radius", None)?;
+                let inner_radius = f.non_negative_or("inner_radius", 0.0)?;
+                if inner_radius >= radius {
+                    return Err(src.error(
+                        f.required("inner_radius")?.span(),
+                        format!("expected an inner_radius below the radius {radius}"),
+                    ));
+                }
+                let disk = Disk::new(
+                    f.vec3_or("center", Vec3::ZERO)?,
+                    f.direction("normal", None)?,
+                    radius,
+                );
+                Shape::Disk(disk.with_partial(Partial {
+                    inner_radius,
+                    phi_max: phi_max(f)?,
+                    ..Partial::WHOLE
+                }))
+            }
             "box" => {
                 let (min, max) = (f.required_vec3("min")?, f.required_vec3("max")?);
                 if min.x >= max.x || min.y >= max.y || min.z >= max.z {
@@ -264,8 +328,12 @@ impl<'s> Reader<'s> {
                 };
                 let radius = f.positive("radius", None)?;
                 let capped = f.bool_or("capped", true)?;
+                let sector = Partial {
+                    phi_max: phi_max(f)?,
+                    ..Partial::WHOLE
+                };
                 let shape = if kind == "cylinder" {
-                    Shape::Cylinder(Cylinder::new(radius, height, capped))
+                    Shape::Cylinder(Cylinder::new(radius, height, capped).with_partial(sector))
                 } else {
                     let top_radius = f.number_or("top_radius", 0.0)?;
                     if top_radius < 0.0 {
@@ -280,6 +348,7 @@ impl<'s> Reader<'s> {
                         height,
                         capped,
                         inside_only: f.bool_or("inside_only", false)?,
+                        partial: sector.cut(),
                     })
                 };
                 return Ok((shape, frame));

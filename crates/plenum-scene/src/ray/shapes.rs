@@ -234,6 +234,7 @@ impl<'s> Parser<'s> {
                     height,
                     capped,
                     inside_only: false,
+                    partial: None,
                 })
             }
         };
