@@ -294,11 +294,20 @@ impl Spectrum {
     /// [`Self::to_rgb_mode`] when rendering in RGB.
     pub fn sample(&self, wl: &SampledWavelengths) -> SampledSpectrum {
         if !wl.is_rgb() {
-            let mut s = SampledSpectrum::ZERO;
-            for i in 0..N_SAMPLES {
-                s[i] = self.eval(wl.lambda()[i]);
-            }
-            return s;
+            // The kinds every scene has, matched once for all lanes.
+            let l = wl.lambda();
+            return SampledSpectrum(match self {
+                Spectrum::Constant(c) => [*c; N_SAMPLES],
+                Spectrum::RgbAlbedo { sigmoid, .. } => sigmoid.eval_lanes(l),
+                Spectrum::RgbUnbounded { scale, sigmoid, .. } => {
+                    sigmoid.eval_lanes(l).map(|s| scale * s)
+                }
+                Spectrum::RgbIlluminant { scale, sigmoid, .. } => {
+                    let s = sigmoid.eval_lanes(l);
+                    std::array::from_fn(|i| scale * s[i] * d65_normalized(l[i]))
+                }
+                _ => l.map(|x| self.eval(x)),
+            });
         }
         let rgb = match self {
             Spectrum::Constant(c) => [*c; 3],

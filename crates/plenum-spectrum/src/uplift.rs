@@ -80,6 +80,23 @@ impl RgbSigmoid {
         sigmoid((self.c0 * lambda + self.c1) * lambda + self.c2)
     }
 
+    /// [`Self::eval`] at each of `lambda`, the same values, written without branches so
+    /// that the lanes are computed together.
+    #[inline]
+    pub fn eval_lanes<const N: usize>(&self, lambda: &[f64; N]) -> [f64; N] {
+        std::array::from_fn(|i| {
+            let x = (self.c0 * lambda[i] + self.c1) * lambda[i] + self.c2;
+            let s = 0.5 + x / (2.0 * (1.0 + x * x).sqrt());
+            // A constant of 0 or 1 has x = ∓∞, where the quotient is NaN.
+            let limit = if x > 0.0 { 1.0 } else { 0.0 };
+            if x.is_infinite() {
+                limit
+            } else {
+                s
+            }
+        })
+    }
+
     /// The spectrum of constant value `v` in [0, 1] (exact: s⁻¹(v) as c2).
     pub fn constant(v: f64) -> Self {
         let v = v.clamp(0.0, 1.0);
@@ -540,6 +557,23 @@ mod tests {
 
     fn max_err(a: [f64; 3], b: [f64; 3]) -> f64 {
         (0..3).map(|i| (a[i] - b[i]).abs()).fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn lanes_evaluate_as_one_at_a_time() {
+        let lambda = [360.0, 451.5, 600.25, 830.0];
+        for s in [
+            RgbSigmoid::constant(0.0),
+            RgbSigmoid::constant(1.0),
+            RgbSigmoid::constant(0.3),
+            RgbSigmoid {
+                c0: 1e-4,
+                c1: -0.1,
+                c2: 20.0,
+            },
+        ] {
+            assert_eq!(s.eval_lanes(&lambda), lambda.map(|l| s.eval(l)), "{s:?}");
+        }
     }
 
     #[test]
