@@ -10,6 +10,7 @@ use crate::reader::{Fields, Result, Source, Value};
 use crate::RenderDefaults;
 use plenum_core::color::Color;
 use plenum_core::geometry::TriangleMesh;
+use plenum_core::material::FloatTexture;
 use plenum_core::math::{Matrix4, Transform, Vec3};
 use plenum_core::scene::{MaterialId, SceneBuilder};
 use plenum_core::texture::{ImageTexture, Texture};
@@ -152,6 +153,24 @@ impl<'s> Reader<'s> {
         } else {
             Ok(c)
         }
+    }
+
+    /// A number in [0, 1] or a texture, read as a grey value (a colour's mean): `what`
+    /// names it in the error.
+    fn fraction(&self, v: &Value<'s>, what: &str) -> Result<FloatTexture> {
+        Ok(match self.texture(v)? {
+            Texture::Constant(c) => {
+                let a = (c.r + c.g + c.b) / 3.0;
+                if !(0.0..=1.0).contains(&a) {
+                    return Err(self.src.error(
+                        v.span(),
+                        format!("expected {what} between 0 and 1, found {a}"),
+                    ));
+                }
+                FloatTexture::Constant(a)
+            }
+            t => FloatTexture::Texture(t),
+        })
     }
 
     fn texture(&self, v: &Value<'s>) -> Result<Texture> {

@@ -8,10 +8,9 @@ use crate::{obj, ply};
 use plenum_core::geometry::{
     Cone, Cuboid, Cylinder, Disk, Partial, Plane, Polygon, Polyhedron, Shape, Sphere, TriangleMesh,
 };
-use plenum_core::material::{FloatTexture, PhongMaterial};
+use plenum_core::material::PhongMaterial;
 use plenum_core::math::{Transform, Vec3};
 use plenum_core::scene::{Alpha, MaterialId};
-use plenum_core::texture::Texture;
 use std::sync::Arc;
 
 impl<'s> Reader<'s> {
@@ -189,19 +188,7 @@ impl<'s> Reader<'s> {
         let Some(v) = f.get("alpha") else {
             return Ok(None);
         };
-        let texture = match self.texture(v)? {
-            Texture::Constant(c) => {
-                let a = (c.r + c.g + c.b) / 3.0;
-                if !(0.0..=1.0).contains(&a) {
-                    return Err(self.src.error(
-                        v.span(),
-                        format!("expected an alpha between 0 and 1, found {a}"),
-                    ));
-                }
-                FloatTexture::Constant(a)
-            }
-            t => FloatTexture::Texture(t),
-        };
+        let texture = self.fraction(v, "an alpha")?;
         Ok(Some(Alpha { texture, cutoff }))
     }
 

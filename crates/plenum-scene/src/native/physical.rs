@@ -185,19 +185,7 @@ impl<'s> Reader<'s> {
                 let b = self.defined_material(&items[1])?;
                 let amount = match f.get("amount") {
                     None => FloatTexture::Constant(0.5),
-                    Some(v) => match self.texture(v)? {
-                        Texture::Constant(c) => {
-                            let a = (c.r + c.g + c.b) / 3.0;
-                            if !(0.0..=1.0).contains(&a) {
-                                return Err(self.src.error(
-                                    v.span(),
-                                    format!("expected an amount between 0 and 1, found {a}"),
-                                ));
-                            }
-                            FloatTexture::Constant(a)
-                        }
-                        t => FloatTexture::Texture(t),
-                    },
+                    Some(v) => self.fraction(v, "an amount")?,
                 };
                 Material::Mix {
                     materials: [a, b],
