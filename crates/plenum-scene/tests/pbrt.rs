@@ -276,7 +276,7 @@ fn errors_and_warnings_are_located() {
     let e = error("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 7 ]\n");
     assert_eq!(e.line, 2, "{e}");
 
-    let l = load("WorldBegin\nLightSource \"infinite\"\nShape \"sphere\" \"float radius\" 1 \"float sparkle\" 2\nShape \"sphere\" \"float zmax\" 0.5\n");
+    let l = load("WorldBegin\nLightSource \"infinite\"\nShape \"sphere\" \"float radius\" 1 \"float sparkle\" 2\nShape \"curve\" \"float width\" 0.5\n");
     let all = l.warnings.join("\n");
     assert_eq!(l.warnings.len(), 2, "{all}");
     assert!(
@@ -285,7 +285,7 @@ fn errors_and_warnings_are_located() {
         "{all}"
     );
     assert!(
-        all.contains(":4:16") && all.contains("partial shapes"),
+        all.contains(":4:1") && all.contains("curves are not supported"),
         "{all}"
     );
 }
