@@ -89,6 +89,11 @@ pub struct TriangleMesh {
     vertex_count: usize,
     triangle_count: usize,
     accel: Accel,
+    /// Where a BVH holds every triangle in one leaf (a mesh of up to `LEAF.max_leaf`
+    /// triangles): its run's place among the nodes and its count. Such a mesh is searched
+    /// by that leaf's test alone, without the root's boxes, which the scene's structure
+    /// has already narrowed down to this mesh.
+    single_leaf: Option<(usize, usize)>,
     bounds: Bounds3,
     /// Every edge joins exactly two triangles: the mesh bounds a solid.
     closed: bool,
@@ -215,6 +220,7 @@ impl TriangleMesh {
             vertex_count: positions.len(),
             triangle_count: triangles.len(),
             accel: Accel::default(),
+            single_leaf: None,
             bounds: Bounds3::from_points(positions.iter().copied().map(widened)),
             closed,
         };
@@ -323,6 +329,13 @@ impl TriangleMesh {
         let embedded = match &mut accel {
             Accel::Bvh(bvh) => bvh.embed_blocks(&blocks, LANES, embed_limit),
             _ => false,
+        };
+        self.single_leaf = match &accel {
+            Accel::Bvh(bvh) if embedded => match bvh.embedded_leaves()[..] {
+                [(place, count)] if count <= LEAF.max_leaf => Some((place, count)),
+                _ => None,
+            },
+            _ => None,
         };
         self.blocks = if embedded {
             LargeArray::default()

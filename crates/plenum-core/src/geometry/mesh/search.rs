@@ -67,6 +67,28 @@ impl TriangleMesh {
                 let first = |search: &Search, run: &Range<usize>| unsafe {
                     search.blocks.add(run.start * EMBED_UNIT) as *const Block
                 };
+                // A mesh of one leaf: that leaf's test alone.
+                if let Some((place, count)) = self.single_leaf {
+                    let block = first(&search, &(place..place + count));
+                    let mut t_max = t_max;
+                    cost::tested(count);
+                    #[cfg(target_arch = "x86_64")]
+                    if let Some(avx) = avx {
+                        // SAFETY: `avx` says the CPU has AVX.
+                        unsafe {
+                            self.search_leaf_avx::<NEAREST>(
+                                avx,
+                                block,
+                                count,
+                                &mut t_max,
+                                &mut search,
+                            )
+                        };
+                        return search.hit;
+                    }
+                    self.search_run_sse::<NEAREST, true>(block, 0..count, &mut t_max, &mut search);
+                    return search.hit;
+                }
                 // The instruction set chosen once, not at every leaf.
                 #[cfg(target_arch = "x86_64")]
                 if let Some(avx) = avx {
