@@ -137,6 +137,7 @@ fn spawned_rays_never_rehit_their_surface() {
                 material: 0,
                 light: None,
                 alpha: None,
+                bump: None,
             };
             let Some(bounds) = prim.world_bounds() else {
                 continue;

@@ -245,6 +245,16 @@ pub fn read_texture(path: &Path) -> Result<Texels, ImageError> {
     Ok(texels(img))
 }
 
+/// [`read_texture`] of an image that holds data rather than colour (a normal map, pbrt's
+/// `"linear"` encoding): 8- and 16-bit values are scaled to [0, 1] as they are.
+pub fn read_data_texture(path: &Path) -> Result<Texels, ImageError> {
+    let img = image::open(path).map_err(|e| ImageError::Read {
+        path: path.display().to_string(),
+        source: e.into(),
+    })?;
+    Ok(texels_as(img, false))
+}
+
 /// [`read_texture`] of an image file's bytes already read (an image inside a glTF buffer or
 /// data URI); `name` says where they came from in messages.
 pub fn decode_texture(bytes: &[u8], name: &str) -> Result<Texels, ImageError> {

@@ -20,7 +20,7 @@ use plenum_core::material::{
     Material, Roughness, SpectralTexture, SpectrumKind, SpectrumValue,
 };
 use plenum_core::math::{Bounds3, Matrix4, Transform, Vec3};
-use plenum_core::scene::{Alpha, MaterialId, SceneBuilder};
+use plenum_core::scene::{Alpha, Bitangent, Bump, MaterialId, SceneBuilder};
 use plenum_core::texture::{ImageTexture, Texture};
 use plenum_spectrum::Spectrum;
 use std::collections::HashMap;
@@ -390,6 +390,9 @@ impl<'a> Reader<'a> {
                 .collect(),
             None => Vec::new(),
         };
+        if p.get(&gltf::Semantic::Tangents).is_some() && p.material().normal_texture().is_some() {
+            self.warn(format!("{at}: TANGENT is not read: the normal map's tangents follow the texture coordinates across each triangle"));
+        }
         let index: Vec<u32> = match p.indices() {
             Some(i) => self.indices(&i)?,
             None => (0..positions.len() as u32).collect(),
@@ -422,7 +425,7 @@ impl<'a> Reader<'a> {
     /// roughness) as stored; alpha as it is.
     fn texels(
         &mut self,
-        info: &gltf::texture::Info,
+        info: &gltf::texture::Info<'_>,
         colour: bool,
         base: &Path,
         at: &str,
@@ -432,16 +435,59 @@ impl<'a> Reader<'a> {
             .as_ref()
             .and_then(|t| t.tex_coord())
             .unwrap_or(info.tex_coord());
+        let uv_map = transform.map(|t| (t.offset(), t.rotation(), t.scale()));
+        self.texels_of(info.texture(), set, uv_map, colour, base, at)
+    }
+
+    /// [`Self::texels`] of a normal map, whose reference the `gltf` crate gives without its
+    /// `KHR_texture_transform`: read here from the extension's JSON.
+    fn normal_texels(
+        &mut self,
+        n: &gltf::material::NormalTexture<'_>,
+        base: &Path,
+        at: &str,
+    ) -> Result<Decoded> {
+        let t = n.extension_value("KHR_texture_transform");
+        let pair = |key: &str, default: [f32; 2]| match t
+            .and_then(|t| t.get(key))
+            .and_then(|v| v.as_array())
+        {
+            Some(a) if a.len() == 2 => [0, 1].map(|i| a[i].as_f64().unwrap_or(0.0) as f32),
+            _ => default,
+        };
+        let set = t
+            .and_then(|t| t.get("texCoord"))
+            .and_then(|v| v.as_u64())
+            .map_or(n.tex_coord(), |v| v as u32);
+        let rotation = t.and_then(|t| t.get("rotation")).and_then(|v| v.as_f64());
+        let uv_map = t.map(|_| {
+            let r = rotation.unwrap_or(0.0) as f32;
+            (pair("offset", [0.0, 0.0]), r, pair("scale", [1.0, 1.0]))
+        });
+        self.texels_of(n.texture(), set, uv_map, false, base, at)
+    }
+
+    /// The image of `texture`, looked up by texture coordinates `set` mapped by
+    /// `KHR_texture_transform`'s (offset, rotation, scale).
+    fn texels_of(
+        &mut self,
+        texture: gltf::Texture<'_>,
+        set: u32,
+        uv_map: Option<([f32; 2], f32, [f32; 2])>,
+        colour: bool,
+        base: &Path,
+        at: &str,
+    ) -> Result<Decoded> {
         if set != 0 {
             self.warn(format!(
                 "{at}: texture coordinates {set} are not supported: using TEXCOORD_0"
             ));
         }
-        let uv_transform = transform.map(|t| {
+        let uv_transform = uv_map.map(|([ox, oy], r, [sx, sy])| {
             // KHR_texture_transform: uv′ = offset + R·(scale ∘ uv) in glTF's (u, v), v down,
             // R turning (u, v) by −rotation as (c, s; −s, c) (the spec's own example, the
             // lower-left quadrant for rotation π/2, scale ½, offset (0, 1), fixes the sign).
-            let ([ox, oy], r, [sx, sy]) = (t.offset(), t.rotation() as f64, t.scale());
+            let r = r as f64;
             let (s, c) = r.sin_cos();
             let (a, b, c0) = (c * sx as f64, s * sy as f64, ox as f64);
             let (d, e, f) = (-s * sx as f64, c * sy as f64, oy as f64);
@@ -449,7 +495,7 @@ impl<'a> Reader<'a> {
             // a·u + b·(1 − v) + c0, v′ = 1 − (d·u + e·(1 − v) + f).
             [[a, -b, b + c0], [-d, e, 1.0 - e - f]]
         });
-        let sampler = info.texture().sampler();
+        let sampler = texture.sampler();
         if sampler.wrap_s() != gltf::texture::WrappingMode::Repeat
             || sampler.wrap_t() != gltf::texture::WrappingMode::Repeat
         {
@@ -457,7 +503,7 @@ impl<'a> Reader<'a> {
                 "{at}: only the repeat wrapping mode is supported: repeating"
             ));
         }
-        let image = info.texture().source();
+        let image = texture.source();
         let iat = format!("images[{}]", image.index());
         let decode = match colour {
             true => plenum_image::decode_texture,
@@ -490,13 +536,18 @@ impl<'a> Reader<'a> {
 
     /// An image texture of `d`'s texels mapped by `value` (a texel's index to a colour).
     fn image_texture(&self, d: &Decoded, value: impl Fn(usize) -> Color) -> Result<Texture> {
+        Ok(Texture::Image(self.image(d, value)?))
+    }
+
+    /// The image of [`Self::image_texture`].
+    fn image(&self, d: &Decoded, value: impl Fn(usize) -> Color) -> Result<Arc<ImageTexture>> {
         let colors = (0..d.texels.rgb.len()).map(value).collect();
         let mut image = ImageTexture::new(d.texels.width, d.texels.height, colors, [1.0, 1.0])
             .ok_or_else(|| self.error(&d.at, "the image is empty"))?;
         if let Some(m) = d.uv_transform {
             image = image.with_uv_transform(m);
         }
-        Ok(Texture::Image(Arc::new(image)))
+        Ok(Arc::new(image))
     }
 
     /// The material's cut-out (none for `OPAQUE`): the base colour's alpha, its factor times
@@ -595,11 +646,22 @@ impl<'a> Reader<'a> {
             }
             (t.transmission_factor() as f64).clamp(0.0, 1.0)
         });
-        if m.normal_texture().is_some() {
-            self.warn(format!(
-                "{at}: the normalTexture is not supported: the surface is smooth"
-            ));
-        }
+        // Tangent-space normals, read as stored (not sRGB); `scale` multiplies x and y.
+        let bump = match m.normal_texture() {
+            Some(n) => {
+                let d = self.normal_texels(&n, base, &format!("{at}.normalTexture"))?;
+                let rgb = |i: usize| {
+                    let t = d.texels.rgb[i];
+                    Color::new(t[0] as f64, t[1] as f64, t[2] as f64)
+                };
+                Some(Bump::NormalMap {
+                    image: self.image(&d, rgb)?,
+                    scale: n.scale() as f64,
+                    bitangent: Bitangent::AlongV,
+                })
+            }
+            None => None,
+        };
         if let Some(s) = m.specular() {
             if s.specular_factor() != 1.0
                 || s.specular_color_factor() != [1.0; 3]
@@ -673,6 +735,9 @@ impl<'a> Reader<'a> {
             }
         };
         let id = self.builder.add_material(name, material);
+        if let Some(bump) = bump {
+            self.builder.set_bump(id, bump);
+        }
         let done = Surface {
             material: id,
             emission,

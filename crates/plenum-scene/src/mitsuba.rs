@@ -11,7 +11,7 @@ use crate::diagnostics::{did_you_mean, SceneError};
 use crate::RenderDefaults;
 use plenum_core::camera::{CameraSettings, Lens};
 use plenum_core::color::Color;
-use plenum_core::geometry::{Cuboid, Cylinder, Disk, Polygon, Shape, Sphere};
+use plenum_core::geometry::{Cuboid, Cylinder, Disk, Shape, Sphere, TriangleMesh};
 use plenum_core::integrator::IntegratorKind;
 use plenum_core::light::{Attenuation, Light};
 use plenum_core::material::{
@@ -21,7 +21,7 @@ use plenum_core::material::{
 };
 use plenum_core::math::{Transform, Vec3};
 use plenum_core::sampling::{FilterKind, SamplerKind};
-use plenum_core::scene::{Alpha, MaterialId, SceneBuilder};
+use plenum_core::scene::{Alpha, Bitangent, Bump, MaterialId, SceneBuilder};
 use plenum_core::texture::{ImageTexture, Texture};
 use plenum_spectrum::Spectrum;
 use std::collections::HashMap;
@@ -83,6 +83,7 @@ pub fn parse(
         warnings: Vec::new(),
         materials: HashMap::new(),
         opacities: HashMap::new(),
+        bumps: HashMap::new(),
         default_diffuse: None,
         in_progress: Vec::new(),
         read: Vec::new(),
@@ -102,6 +103,8 @@ struct Builder<'d> {
     materials: HashMap<usize, MaterialId>,
     /// Per BSDF object: the opacity of a `mask` it is or holds (through `twosided`).
     opacities: HashMap<usize, FloatTexture>,
+    /// Per BSDF object: the map of a `normalmap` or `bumpmap` it is or holds.
+    bumps: HashMap<usize, Bump>,
     default_diffuse: Option<MaterialId>,
     /// BSDFs being mapped, to refuse one that contains itself.
     in_progress: Vec<usize>,
@@ -360,11 +363,12 @@ impl<'d> Builder<'d> {
                     .string(t, "filename")?
                     .ok_or_else(|| self.doc.error(&ob.loc, "a bitmap needs a `filename`"))?;
                 let path = self.doc.base_dir(floc.file).join(file);
-                let texels = plenum_image::read_texture(&path)
-                    .map_err(|e| self.doc.error(floc, e.to_string()))?;
-                if self.boolean(t, "raw", false)? {
-                    self.warn(&ob.loc, "`raw`: Plenum decodes 8-bit images as sRGB always");
+                // `raw`: the values as stored (data such as normals), not sRGB-decoded.
+                let texels = match self.boolean(t, "raw", false)? {
+                    true => plenum_image::read_data_texture(&path),
+                    false => plenum_image::read_texture(&path),
                 }
+                .map_err(|e| self.doc.error(floc, e.to_string()))?;
                 for (key, default) in [("filter_type", "bilinear"), ("wrap_mode", "repeat")] {
                     if let Some((v, l)) = self.string(t, key)? {
                         if v != default {
@@ -420,6 +424,54 @@ impl<'d> Builder<'d> {
             );
         }
         Ok([su.abs().max(1e-9), sv.abs().max(1e-9)])
+    }
+
+    /// A `normalmap`'s image (its texture named `normalmap`: tangent-space normals, which
+    /// Mitsuba reads with `raw` set) or a `bumpmap`'s height texture times its `scale`.
+    /// `None` where the surface stays smooth (a constant height, warned otherwise).
+    fn bump_map(&mut self, o: usize, normal: bool) -> Result<Option<Bump>> {
+        let textures = self.children(o, "texture")?;
+        let ob = self.obj(o);
+        let found = match normal {
+            true => textures.iter().find(|(_, p)| p.name == "normalmap"),
+            false => textures.first(),
+        };
+        let Some(&(_, p)) = found else {
+            let what = if normal {
+                "a texture named `normalmap`"
+            } else {
+                "a texture"
+            };
+            return Err(self
+                .doc
+                .error(&ob.loc, format!("a {} needs {what}", ob.plugin)));
+        };
+        let texture = self.texture_of(p)?;
+        if normal {
+            return Ok(match texture {
+                Texture::Image(image) => Some(Bump::NormalMap {
+                    image,
+                    scale: 1.0,
+                    bitangent: Bitangent::NormalCrossU,
+                }),
+                _ => {
+                    let l = p.loc.clone();
+                    self.warn(
+                        &l,
+                        "a normal map other than a bitmap: the surface is smooth",
+                    );
+                    None
+                }
+            });
+        }
+        let scale = self.float(o, "scale", 1.0)?;
+        Ok(match texture {
+            Texture::Constant(_) => None,
+            height => Some(Bump::HeightMap {
+                height: FloatTexture::Texture(height),
+                scale,
+            }),
+        })
     }
 
     /// A roughness α: a float or a texture.
@@ -556,6 +608,9 @@ impl<'d> Builder<'d> {
         if !b.two_sided {
             self.builder.set_one_sided(id);
         }
+        if let Some(bump) = self.bumps.get(&o).cloned() {
+            self.builder.set_bump(id, bump);
+        }
         self.materials.insert(o, id);
         Ok(id)
     }
@@ -660,6 +715,9 @@ impl<'d> Builder<'d> {
                 if let Some(opacity) = self.opacities.get(&front).cloned() {
                     self.opacities.insert(o, opacity);
                 }
+                if let Some(bump) = self.bumps.get(&front).cloned() {
+                    self.bumps.insert(o, bump);
+                }
                 Bsdf {
                     material,
                     two_sided: true,
@@ -714,12 +772,8 @@ impl<'d> Builder<'d> {
                         }
                     }
                     self.opacities.insert(o, opacity);
-                } else {
-                    let l = ob.loc.clone();
-                    self.warn(
-                        &l,
-                        "bump and normal maps are not supported: the surface is smooth",
-                    );
+                } else if let Some(bump) = self.bump_map(o, ob.plugin == "normalmap")? {
+                    self.bumps.insert(o, bump);
                 }
                 self.prop(o, "_arg_0");
                 for p in &self.obj(o).props {
@@ -728,6 +782,10 @@ impl<'d> Builder<'d> {
                     }
                 }
                 let inner_bsdf = self.bsdf(inner, depth + 1)?;
+                // A map inside a mask (or a map in a map: the outer one is used).
+                if let Some(bump) = self.bumps.get(&inner).cloned() {
+                    self.bumps.entry(o).or_insert(bump);
+                }
                 // A mask around a mask: their opacities multiply, but only constants are
                 // multiplied here.
                 if let Some(inner_opacity) = self.opacities.get(&inner).cloned() {
@@ -949,11 +1007,16 @@ impl<'d> Builder<'d> {
         ];
         let shape = match ob.plugin.as_str() {
             "rectangle" => {
-                let mut v = square.to_vec();
-                if flip {
-                    v.reverse();
-                }
-                Shape::Polygon(Box::new(Polygon::new(v).expect("a square is a polygon")))
+                // Two triangles with Mitsuba's (u, v): (0, 0) at (−1, −1), u along x, v
+                // along y, and v down the image, so Plenum's v (up the image) is 1 − v.
+                let uvs = vec![[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]];
+                let triangles = match flip {
+                    false => vec![[0, 1, 2], [0, 2, 3]],
+                    true => vec![[0, 2, 1], [0, 3, 2]],
+                };
+                let mesh = TriangleMesh::new(square.to_vec(), triangles, vec![], uvs)
+                    .expect("a square is a mesh");
+                Shape::Mesh(Arc::new(mesh))
             }
             "disk" => {
                 let n = if flip { -Vec3::Z } else { Vec3::Z };

@@ -21,7 +21,7 @@ use plenum_core::material::{
 };
 use plenum_core::math::{Matrix4, Transform, Vec3};
 use plenum_core::sampling::{FilterKind, SamplerKind};
-use plenum_core::scene::{Alpha, MaterialId, SceneBuilder};
+use plenum_core::scene::{Alpha, Bitangent, Bump, MaterialId, SceneBuilder};
 use plenum_core::texture::{ImageTexture, Texture};
 use plenum_spectrum::Spectrum;
 use std::cell::Cell;
@@ -1560,19 +1560,57 @@ impl Parser {
                 })
             }
         };
-        for key in ["displacement", "normalmap"] {
-            if let Some(q) = p.get(key) {
-                let l = q.loc.clone();
-                self.warn(
-                    &l,
-                    format!("`{key}` is not supported: the surface is smooth"),
-                );
-            }
-        }
+        let bump = self.bump(p)?;
         p.get("type");
         self.count += 1;
         let name = name.map_or_else(|| format!("{ty} {}", self.count), str::to_string);
-        Ok(self.builder.add_material(name, m))
+        let id = self.builder.add_material(name, m);
+        if let Some(bump) = bump {
+            self.builder.set_bump(id, bump);
+        }
+        Ok(id)
+    }
+
+    /// A material's `normalmap` (an image file of tangent-space normals, read linear) or
+    /// `displacement` (a float texture: a bump map); a normal map wins where both are
+    /// given, as in pbrt-v4.
+    fn bump(&mut self, p: &Params) -> Result<Option<Bump>> {
+        let displacement = match p.get("displacement") {
+            Some(_) => Some(self.float_texture(p, "displacement", 0.0)?),
+            None => None,
+        };
+        if let Some((file, floc)) = self.string(p, "normalmap")? {
+            let path = self.path_in(floc.file, file);
+            return Ok(match plenum_image::read_data_texture(&path) {
+                Ok(t) => {
+                    let texels = t
+                        .rgb
+                        .iter()
+                        .map(|c| Color::new(c[0] as f64, c[1] as f64, c[2] as f64));
+                    let image = ImageTexture::new(t.width, t.height, texels.collect(), [1.0, 1.0])
+                        .ok_or_else(|| self.error(&floc, "the image is empty"))?;
+                    if displacement.is_some() {
+                        self.warn(
+                            &floc,
+                            "both a normal map and a displacement: the normal map is used",
+                        );
+                    }
+                    Some(Bump::NormalMap {
+                        image: Arc::new(image),
+                        scale: 1.0,
+                        bitangent: Bitangent::NormalCrossU,
+                    })
+                }
+                Err(e) => {
+                    self.warn(&floc, format!("{e}: the surface is smooth"));
+                    None
+                }
+            });
+        }
+        Ok(displacement.and_then(|height| match height {
+            FloatTexture::Constant(_) => None,
+            height => Some(Bump::HeightMap { height, scale: 1.0 }),
+        }))
     }
 
     fn texture(&mut self, class: &str, ty: &str, p: &Params, loc: &Loc) -> Result<Texture> {
@@ -1628,14 +1666,17 @@ impl Parser {
                 let invert = self.boolean_param(p, "invert", false)?;
                 p.get("filter");
                 p.get("maxanisotropy");
+                let mut linear = false;
                 if let Some((e, l)) = self.string(p, "encoding")? {
-                    if e != "sRGB" {
-                        self.warn(
+                    match e {
+                        "sRGB" => {}
+                        "linear" => linear = true,
+                        _ => self.warn(
                             &l,
                             format!(
                                 "encoding `{e}` is not supported: 8-bit images are read as sRGB"
                             ),
-                        );
+                        ),
                     }
                 }
                 if let Some((w, l)) = self.string(p, "wrap")? {
@@ -1643,7 +1684,12 @@ impl Parser {
                         self.warn(&l, format!("wrap `{w}` is not supported: repeating"));
                     }
                 }
-                match plenum_image::read_texture(&path) {
+                let read = if linear {
+                    plenum_image::read_data_texture(&path)
+                } else {
+                    plenum_image::read_texture(&path)
+                };
+                match read {
                     Ok(texels) => {
                         let (width, height) = (texels.width, texels.height);
                         let texels: Vec<Color> = texels

@@ -410,6 +410,13 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                 let _ = writeln!(w, "alpha_cutoff = {c:?}");
             }
         }
+        if p.bump.is_some() {
+            // The image a map was read from is not kept, so it cannot be named here.
+            let _ = writeln!(
+                w,
+                "# its material's normal or bump map is not written: add `normal_map` or `bump` to the material"
+            );
+        }
         let _ = writeln!(w);
     }
     out

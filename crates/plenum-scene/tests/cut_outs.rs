@@ -1,7 +1,7 @@
 //! Cut-outs and partial shapes in the native format: `alpha` (a number or a texture, an
 //! image's alpha channel among them) and `alpha_cutoff` on objects; `z_min`, `z_max`,
-//! `inner_radius` and `phi_max` on quadrics; their located errors, and `plenum convert`
-//! writing them back.
+//! `inner_radius` and `phi_max` on quadrics; normal and bump maps on physical materials
+//! (`normal_map`, `bump`); their located errors, and `plenum convert` writing them back.
 
 mod common;
 
@@ -219,4 +219,72 @@ fn bad_cuts_are_located_errors() {
         let at = format!("scene.toml:{line}:");
         assert!(e.contains(what) && e.contains(&at), "{object}: {e}");
     }
+}
+
+#[test]
+fn normal_and_bump_maps_on_physical_materials_turn_the_shading_normal() {
+    use plenum_core::math::{Ray, Vec3};
+    // The square of `scene` faces +z with u along +x and v along +y, one unit of each.
+    let with = |material: &str| {
+        scene("").replace(
+            "[materials.black]\ntype = \"diffuse\"\nreflectance = 0.0",
+            &format!("[materials.black]\ntype = \"diffuse\"\nreflectance = 0.0\n{material}"),
+        )
+    };
+    let tilted = png(1, 1, 3, &[191, 128, 221]);
+    let ramp = png(2, 1, 3, &[0, 0, 0, 255, 255, 255]);
+    let load = |material: &str| {
+        let text = with(material);
+        let files = [
+            ("scene.toml", text.as_bytes()),
+            ("n.png", &tilted[..]),
+            ("ramp.png", &ramp[..]),
+        ];
+        load_files(&files)
+    };
+    let shading_normal = |material: &str| {
+        let l = load(material).unwrap_or_else(|e| panic!("{e}"));
+        let ray = Ray::new(Vec3::new(0.0, 0.1, 3.0), -Vec3::Z);
+        let (prim, hit) = l.scene.geometry.intersect(&ray, f64::INFINITY).unwrap();
+        assert_eq!(l.scene.geometry.names[prim as usize], "square");
+        l.scene.geometry.interaction(&ray, prim, &hit).shading_n
+    };
+    let decode = |b: u8| 2.0 * b as f64 / 255.0 - 1.0;
+    let got = shading_normal("normal_map = \"n.png\"");
+    let want = Vec3::new(decode(191), decode(128), decode(221)).normalized();
+    assert!((got - want).length() < 1e-6, "{got:?} vs {want:?}");
+    let got = shading_normal("normal_map = \"n.png\"\nnormal_scale = 0");
+    assert!((got - Vec3::Z).length() < 1e-9, "{got:?}");
+    // Heights 0 and 1 at u = 0.25 and 0.75, times 0.1: a slope of 0.2 toward +x.
+    let got = shading_normal(
+        "bump = { texture = \"image\", file = \"ramp.png\", encoding = \"linear\" }\nbump_scale = 0.1",
+    );
+    let want = Vec3::new(-0.2, 0.0, 1.0).normalized();
+    assert!((got - want).length() < 1e-6, "{got:?} vs {want:?}");
+    // Located errors.
+    for (material, message, line) in [
+        ("normal_map = \"n.png\"\nbump = 0.5", "not both", ":11:"),
+        ("bump_scale = 2", "without a `bump`", ":10:"),
+        (
+            "bump = { texture = \"image\", file = \"ramp.png\", encoding = \"gamma\" }",
+            "unknown encoding",
+            ":10:",
+        ),
+        ("normal_map = \"missing.png\"", "missing.png", ":10:"),
+    ] {
+        let Err(e) = load(material) else {
+            panic!("{material}: expected an error");
+        };
+        assert!(
+            e.message.contains(message) && e.to_string().contains(line),
+            "{material}: {e}"
+        );
+    }
+    // `plenum convert` cannot name the image: it says so on the object.
+    let l = load("normal_map = \"n.png\"").unwrap();
+    let written = plenum_scene::to_toml(&l.scene, &l.defaults);
+    assert!(
+        written.contains("normal or bump map is not written"),
+        "{written}"
+    );
 }

@@ -538,3 +538,44 @@ fn texture_transforms_map_the_uvs_as_the_extensions_examples_say() {
     assert_eq!(rgb(&flipped, 0.3, 0.7), [0.0, 0.0, 1.0]);
     assert_eq!(rgb(&flipped, 0.7, 0.3), [0.0, 1.0, 0.0]);
 }
+
+#[test]
+fn the_normal_texture_turns_the_shading_normal_in_its_tangent_frame() {
+    // The textured square faces +z with glTF's u along +x and v down (−y). Tangent-space x
+    // follows u and y points up the image (+y here); the texels are linear, and `scale`
+    // multiplies x and y. Tilts of about 30°: (191 → 0.498, 221 → 0.733). Texels are
+    // decoded to f32, hence the tolerance of 1e-6.
+    use plenum_core::math::{Ray, Vec3};
+    let shading_normal = |material: &str, image: &[u8], x: f64| {
+        let l = textured_square(material, image);
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        let ray = Ray::new(Vec3::new(x, 0.1, 3.0), -Vec3::Z);
+        let (prim, hit) = l.scene.geometry.intersect(&ray, f64::INFINITY).unwrap();
+        assert_eq!(prim, 0);
+        l.scene.geometry.interaction(&ray, prim, &hit).shading_n
+    };
+    let decode = |b: u8| 2.0 * b as f64 / 255.0 - 1.0;
+    let unit = |x: f64, y: f64, z: f64| Vec3::new(x, y, z).normalized();
+    let plain = r#"{"normalTexture": {"index": 0}}"#;
+    let right = png(1, 1, 3, &[191, 128, 221]);
+    let got = shading_normal(plain, &right, 0.0);
+    let want = unit(decode(191), decode(128), decode(221));
+    assert!((got - want).length() < 1e-6, "{got:?} vs {want:?}");
+    let up = png(1, 1, 3, &[128, 191, 221]);
+    let got = shading_normal(plain, &up, 0.0);
+    let want = unit(decode(128), decode(191), decode(221));
+    assert!((got - want).length() < 1e-6, "up: {got:?} vs {want:?}");
+    let half = r#"{"normalTexture": {"index": 0, "scale": 0.5}}"#;
+    let got = shading_normal(half, &right, 0.0);
+    let want = unit(0.5 * decode(191), 0.5 * decode(128), decode(221));
+    assert!((got - want).length() < 1e-6, "scale ½: {got:?} vs {want:?}");
+    // KHR_texture_transform on the normal texture: a 2 × 1 image tilted right on its left
+    // texel and left on its right one, shifted by half its width.
+    let both = png(2, 1, 3, &[191, 128, 221, 64, 128, 221]);
+    let got = shading_normal(plain, &both, -0.25);
+    assert!(got.x > 0.4, "{got:?}");
+    let shifted = r#"{"normalTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"offset": [0.5, 0]}}}}"#;
+    let got = shading_normal(shifted, &both, -0.25);
+    let want = unit(decode(64), decode(128), decode(221));
+    assert!((got - want).length() < 1e-6, "shifted: {got:?} vs {want:?}");
+}

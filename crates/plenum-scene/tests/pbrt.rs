@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{bright_centre, load_files, native, number};
+use common::{bright_centre, load_files, native, number, png};
 
 use common::integrators::{cbox_z_test_of, draw, path_settings};
 use plenum_core::integrator::{ColorMode, IntegratorKind};
@@ -693,6 +693,75 @@ Shape "sphere" "float phimax" 90
         l.warnings.len() == 1
             && l.warnings[0].contains("whole shape emits")
             && l.warnings[0].contains(":7:"),
+        "{:?}",
+        l.warnings
+    );
+}
+
+#[test]
+fn normal_maps_and_displacement_turn_the_shading_normal() {
+    // A diffuse square facing the camera at z = 5, u along +x and v along +y, lit only by a
+    // distant light from 30° toward +x. A delta light and no other surface: one sample per
+    // pixel is exact, and the radiance is proportional to cos(light, shading normal). A flat
+    // square shows cos 30°; a normal map tilted by τ toward +u shows cos(30° − τ), a map
+    // tilted toward −u cos(30° + τ). The normal map's texel is decoded linearly (not sRGB).
+    let picture = |material: &str, files: &[(&str, &[u8])]| {
+        let text = format!(
+            r#"{VIEW}LightSource "distant" "point3 from" [ 0.5 0 {z} ] "point3 to" [ 0 0 0 ] "rgb L" [ 1 1 1 ]
+Texture "ramp" "float" "imagemap" "string filename" "ramp.png" "string encoding" "linear"
+Material "diffuse" "rgb reflectance" [ 0.5 0.5 0.5 ] {material}
+Shape "trianglemesh" "point3 P" [ -5 -5 5  -5 5 5  5 5 5  5 -5 5 ]
+  "point2 uv" [ 0 0  0 1  1 1  1 0 ] "integer indices" [ 0 1 2  0 2 3 ]
+"#,
+            z = -(0.75f64.sqrt()),
+        );
+        let ramp = png(2, 1, 3, &[0, 0, 0, 255, 255, 255]);
+        let mut all = vec![("scene.pbrt", text.as_bytes()), ("ramp.png", &ramp[..])];
+        all.extend_from_slice(files);
+        let l = load_files(&all).unwrap_or_else(|e| panic!("{e}"));
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        let image = draw(&l, &path_settings(&l, 1, ColorMode::Rgb, 5));
+        image[16 * 32 + 16][1] as f64
+    };
+    let flat = picture("", &[]);
+    assert!(flat > 0.01);
+    // The texel (191, 128, 221): x = 2·191/255 − 1 and so on, a normal tilted toward +u.
+    let tilted = png(1, 1, 3, &[191, 128, 221]);
+    let n = [191.0, 128.0, 221.0].map(|b: f64| 2.0 * b / 255.0 - 1.0);
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    let light = [0.5, 0.0, 0.75f64.sqrt()];
+    let cos = |sx: f64| (sx * n[0] * light[0] + n[1] * light[1] + n[2] * light[2]) / len;
+    let got = picture(r#""string normalmap" "up.png""#, &[("up.png", &tilted)]);
+    let want = flat * cos(1.0) / light[2];
+    assert!(
+        (got - want).abs() < 1e-4 * want,
+        "toward +u: {got} vs {want}"
+    );
+    let away = png(1, 1, 3, &[255 - 191, 128, 221]);
+    let got = picture(r#""string normalmap" "away.png""#, &[("away.png", &away)]);
+    let want = flat * cos(-1.0) / light[2];
+    assert!(
+        (got - want).abs() < 1e-4 * want,
+        "toward −u: {got} vs {want}"
+    );
+    // Displacement by a ramp rising 1 unit over half a unit of u (texel centres at u = 0.25
+    // and 0.75) on a square 10 units wide: slope 0.2, the normal tilted by atan 0.2 toward
+    // −u, away from the light: cos(30° + atan 0.2).
+    let got = picture(r#""texture displacement" "ramp""#, &[]);
+    let tilt = 0.2f64.atan();
+    let want = flat * (std::f64::consts::FRAC_PI_6 + tilt).cos() / light[2];
+    assert!(
+        (got - want).abs() < 1e-4 * want,
+        "displacement: {got} vs {want}"
+    );
+    // A missing normal map is a located warning, and the surface stays smooth.
+    let text =
+        format!("{VIEW}Material \"diffuse\" \"string normalmap\" \"gone.png\"\nShape \"sphere\"\n");
+    let l = load(&text);
+    assert!(
+        l.warnings
+            .iter()
+            .any(|w| w.contains("scene.pbrt:6:") && w.contains("smooth")),
         "{:?}",
         l.warnings
     );

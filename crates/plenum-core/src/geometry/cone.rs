@@ -134,6 +134,26 @@ impl Cone {
             SurfaceGeometry::flat(p, p.abs() * gamma(4), n, uv)
         }
     }
+
+    /// ∂p/∂u and ∂p/∂v at `p` (see `surface`): on the side, around (u = φ/2π) and up the
+    /// slant (v = z/height); on a cap, along x and y across its diameter.
+    pub fn uv_derivatives(&self, hit: &HitRecord, p: Vec3) -> [Vec3; 2] {
+        if hit.part == SIDE {
+            let r = self.radius_at(p.z);
+            let k = if r > 0.0 { self.slope() / r } else { 0.0 };
+            [
+                Vec3::new(-p.y, p.x, 0.0) * (2.0 * PI),
+                Vec3::new(k * p.x, k * p.y, 1.0) * self.height,
+            ]
+        } else {
+            let r = if hit.part == BOTTOM {
+                self.radius0
+            } else {
+                self.radius1
+            };
+            [Vec3::X * (2.0 * r), Vec3::Y * (2.0 * r)]
+        }
+    }
 }
 
 #[cfg(test)]

@@ -81,6 +81,17 @@ impl Cuboid {
         ];
         SurfaceGeometry::flat(p, p.abs() * gamma(4), Vec3::from_array(n), uv)
     }
+
+    /// The face's edges along which u and v run (see `surface`).
+    pub fn uv_derivatives(&self, hit: &HitRecord) -> [Vec3; 2] {
+        let axis = (hit.part / 2) as usize;
+        let size = (self.max - self.min).to_array();
+        [(axis + 1) % 3, (axis + 2) % 3].map(|a| {
+            let mut e = [0.0; 3];
+            e[a] = size[a];
+            Vec3::from_array(e)
+        })
+    }
 }
 
 #[cfg(test)]

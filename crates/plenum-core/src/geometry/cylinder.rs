@@ -2,7 +2,7 @@
 //! a cone whose two radii are equal.
 
 use super::{Cone, HitRecord, Partial, SurfaceGeometry};
-use crate::math::{Bounds3, Ray};
+use crate::math::{Bounds3, Ray, Vec3};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cylinder {
@@ -55,6 +55,10 @@ impl Cylinder {
 
     pub fn surface(&self, ray: &Ray, hit: &HitRecord, want_uv: bool) -> SurfaceGeometry {
         self.shape.surface(ray, hit, want_uv)
+    }
+
+    pub fn uv_derivatives(&self, hit: &HitRecord, p: Vec3) -> [Vec3; 2] {
+        self.shape.uv_derivatives(hit, p)
     }
 }
 

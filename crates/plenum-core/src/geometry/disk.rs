@@ -77,6 +77,21 @@ impl Disk {
         };
         SurfaceGeometry::flat(p, p_error, self.normal, uv)
     }
+
+    /// ∂p/∂u and ∂p/∂v at `p`, for u = φ/2π and v = ρ/R: around and outward. Zero ∂p/∂u
+    /// at the centre.
+    pub fn uv_derivatives(&self, p: Vec3) -> [Vec3; 2] {
+        let d = p - self.center;
+        let (x, y) = (d.dot(self.tangent_s), d.dot(self.tangent_t));
+        let rho = (x * x + y * y).sqrt();
+        let around = (self.tangent_t * x - self.tangent_s * y) * (2.0 * PI);
+        let outward = if rho > 0.0 {
+            (self.tangent_s * x + self.tangent_t * y) * (self.radius / rho)
+        } else {
+            self.tangent_s * self.radius
+        };
+        [around, outward]
+    }
 }
 
 #[cfg(test)]

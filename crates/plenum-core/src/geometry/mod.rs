@@ -130,6 +130,31 @@ impl Shape {
         }
     }
 
+    /// ∂p/∂u and ∂p/∂v at a hit whose geometry is `g` (computed with texture coordinates),
+    /// in the shape's coordinates: the tangent frame of normal and bump maps. Where the
+    /// parametrisation is singular (a sphere's pole, a disk's centre, a triangle with
+    /// degenerate uvs) some orthonormal pair around the normal.
+    pub fn uv_derivatives(&self, hit: &HitRecord, g: &SurfaceGeometry) -> [Vec3; 2] {
+        let [dpdu, dpdv] = match self {
+            Shape::Sphere(s) => s.uv_derivatives(g.p),
+            Shape::Plane(s) => s.uv_derivatives(),
+            Shape::Disk(s) => s.uv_derivatives(g.p),
+            Shape::Cuboid(s) => s.uv_derivatives(hit),
+            Shape::Cylinder(s) => s.uv_derivatives(hit, g.p),
+            Shape::Cone(s) => s.uv_derivatives(hit, g.p),
+            Shape::Polygon(s) => s.uv_derivatives(),
+            Shape::Polyhedron(s) => s.uv_derivatives(hit),
+            Shape::Mesh(s) => s.uv_derivatives(hit),
+        };
+        let spanned = dpdu.cross(dpdv).length_squared();
+        if spanned > 1e-24 * dpdu.length_squared() * dpdv.length_squared() && spanned.is_finite() {
+            [dpdu, dpdv]
+        } else {
+            let (s, t) = g.shading_n.orthonormal_basis();
+            [s, t]
+        }
+    }
+
     /// Bounds in the shape's coordinates; `None` for unbounded shapes (the infinite plane).
     pub fn bounds(&self) -> Option<Bounds3> {
         match self {

@@ -46,6 +46,11 @@ impl Plane {
         let uv = [d.dot(self.tangent_s), d.dot(self.tangent_t)];
         SurfaceGeometry::flat(p, p_error, self.normal, uv)
     }
+
+    /// The unit axes of (u, v).
+    pub fn uv_derivatives(&self) -> [Vec3; 2] {
+        [self.tangent_s, self.tangent_t]
+    }
 }
 
 #[cfg(test)]

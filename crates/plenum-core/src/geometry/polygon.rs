@@ -144,6 +144,11 @@ impl Polygon {
         let uv = [d.dot(self.tangent_s), d.dot(self.tangent_t)];
         SurfaceGeometry::flat(p, p_error, self.normal, uv)
     }
+
+    /// The unit axes of (u, v).
+    pub fn uv_derivatives(&self) -> [Vec3; 2] {
+        [self.tangent_s, self.tangent_t]
+    }
 }
 
 impl Polygon {

@@ -130,6 +130,10 @@ impl Polyhedron {
     pub fn surface(&self, ray: &Ray, hit: &HitRecord) -> SurfaceGeometry {
         self.faces[hit.part as usize].surface(ray, hit)
     }
+
+    pub fn uv_derivatives(&self, hit: &HitRecord) -> [Vec3; 2] {
+        self.faces[hit.part as usize].uv_derivatives()
+    }
 }
 
 /// Every edge of a closed surface joins exactly two faces, and consistently wound faces

@@ -105,6 +105,21 @@ impl Sphere {
         };
         SurfaceGeometry::flat(p, p_error, n, uv)
     }
+
+    /// ∂p/∂u and ∂p/∂v at `p` on the sphere, for the map of `surface`: p = c + r·(sin θ sin φ,
+    /// cos θ, sin θ cos φ) with φ = 2πu and θ = πv. Zero at the poles.
+    pub fn uv_derivatives(&self, p: Vec3) -> [Vec3; 2] {
+        let o = p - self.center;
+        // ρ = r sin θ, the distance from the axis.
+        let rho = (o.x * o.x + o.z * o.z).sqrt();
+        let dpdu = Vec3::new(o.z, 0.0, -o.x) * (2.0 * PI);
+        let dpdv = if rho > 0.0 {
+            Vec3::new(o.y * o.x / rho, -rho, o.y * o.z / rho) * PI
+        } else {
+            Vec3::ZERO
+        };
+        [dpdu, dpdv]
+    }
 }
 
 #[cfg(test)]

@@ -28,6 +28,7 @@ use crate::bxdf::{Bsdf, TransportMode};
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::SplatBuffer;
+use crate::light::AREA_SHADOW_END;
 use crate::material::rgb_radiance;
 use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::sampling::SampleStream;
@@ -728,10 +729,15 @@ impl<'a> BidirectionalPathTracer<'a> {
         let from = lift(a, b.p);
         let to = lift(b, a.p);
         let ray = Ray::new(from, to - from).at_time(time);
+        // A surface at the far end (a mesh's, tested in f32) may be met a hair before it.
+        let t_max = match b.kind {
+            Kind::Surface => AREA_SHADOW_END,
+            _ => 1.0 - 1e-9,
+        };
         !self
             .scene
             .geometry
-            .occluded(&ray, 1.0 - 1e-9, Coherence::Incoherent)
+            .occluded(&ray, t_max, Coherence::Incoherent)
     }
 
     fn connectible(&self, v: &Vertex) -> bool {

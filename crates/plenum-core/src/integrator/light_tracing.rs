@@ -25,7 +25,7 @@ use crate::bxdf::TransportMode;
 use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::SplatBuffer;
-use crate::light::{EmissionSample, Light};
+use crate::light::{EmissionSample, Light, AREA_SHADOW_END};
 use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::sampling::SampleStream;
 use crate::scene::Scene;
@@ -195,7 +195,7 @@ impl<'a> LightTracer<'a> {
         if self
             .scene
             .geometry
-            .occluded(&shadow, 1.0 - 1e-4, Coherence::Incoherent)
+            .occluded(&shadow, AREA_SHADOW_END, Coherence::Incoherent)
         {
             return None;
         }

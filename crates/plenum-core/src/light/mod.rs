@@ -419,8 +419,9 @@ pub struct Incident {
 
 /// Shadow rays to a point light stop just short of it.
 const POINT_SHADOW_END: f64 = 1.0 - 1e-9;
-/// Shadow rays to an area light stop this far short of the sampled point.
-const AREA_SHADOW_END: f64 = 1.0 - 1e-4;
+/// Shadow rays to an area light stop this far short of the sampled point; so do rays to
+/// any surface point, which a mesh's single-precision test may find a little early.
+pub(crate) const AREA_SHADOW_END: f64 = 1.0 - 1e-4;
 
 impl Light {
     pub fn is_area(&self) -> bool {

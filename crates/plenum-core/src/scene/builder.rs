@@ -1,6 +1,7 @@
 //! Collects the parts of a scene (objects, materials, lights, camera), then builds it.
 
 use super::alpha::Alpha;
+use super::bump::Bump;
 use super::geometry::Geometry;
 use super::lights::Lights;
 use super::materials::Materials;
@@ -15,6 +16,7 @@ use crate::light_sampler::LightSamplerKind;
 use crate::material::{Material, MaterialId, PhongMaterial};
 use crate::math::{Motion, Transform};
 use plenum_spectrum::Spectrum;
+use std::collections::HashMap;
 use std::sync::Arc;
 
 /// Collects the parts of a scene, then builds the acceleration structure.
@@ -34,6 +36,8 @@ pub struct SceneBuilder {
     /// Per light: a spectrum given in place of its RGB value, and a scale.
     light_spectra: Vec<Option<(Spectrum, f64)>>,
     one_sided: Vec<MaterialId>,
+    /// Normal and bump maps by material: every object of the material is given its map.
+    bumps: HashMap<MaterialId, Arc<Bump>>,
     light_sampler: LightSamplerKind,
 }
 
@@ -51,6 +55,12 @@ impl SceneBuilder {
         if let Some(Light::Area { two_sided, .. }) = self.lights.last_mut() {
             *two_sided = false;
         }
+    }
+
+    /// Turns the shading normal of every object of material `id` placed from now on by a
+    /// normal or bump map (see [`Bump`]): the formats give these maps with the material.
+    pub fn set_bump(&mut self, id: MaterialId, bump: Bump) {
+        self.bumps.insert(id, Arc::new(bump));
     }
 
     /// Makes material `id` scatter only on the side its surfaces' normals point to (seen
@@ -146,6 +156,7 @@ impl SceneBuilder {
             vertex_materials: None,
             light: None,
             alpha: None,
+            bump: self.bumps.get(&material).cloned(),
         });
         self.object_names.push(name.into());
     }

@@ -4,6 +4,7 @@
 
 mod alpha;
 mod builder;
+mod bump;
 mod geometry;
 mod lights;
 mod materials;
@@ -12,6 +13,7 @@ mod primitive;
 pub use crate::material::MaterialId;
 pub use alpha::Alpha;
 pub use builder::SceneBuilder;
+pub use bump::{Bitangent, Bump, UvDerivatives};
 pub use geometry::Geometry;
 pub use lights::Lights;
 pub use materials::Materials;

@@ -2,8 +2,9 @@
 //! in world space.
 
 use super::alpha::Alpha;
+use super::bump::{Bump, UvDerivatives};
 use crate::accel::Coherence;
-use crate::geometry::{HitRecord, Shape};
+use crate::geometry::{HitRecord, Shape, SurfaceGeometry};
 use crate::material::MaterialId;
 use crate::math::{gamma, offset_ray_origin, Bounds3, Motion, Ray, Transform, Vec3};
 use crate::texture::TextureCoords;
@@ -26,6 +27,8 @@ pub struct Primitive {
     pub light: Option<u32>,
     /// A cut-out: the surface is there only where this says (none: everywhere).
     pub alpha: Option<Arc<Alpha>>,
+    /// A normal or bump map that turns the shading normal (none: the shape's own).
+    pub bump: Option<Arc<Bump>>,
 }
 
 /// The most cut-away hits one query passes on one primitive before it gives up and reports
@@ -121,18 +124,24 @@ impl Primitive {
         primitive: u32,
         want_uv: bool,
     ) -> Interaction {
+        let want_uv = want_uv || self.bump.is_some();
         self.placed(ray.time, |placement| match placement {
             None => {
                 let g = self.shape.surface(ray, hit, want_uv);
+                let texture = TextureCoords {
+                    uv: g.uv,
+                    object_point: g.p,
+                };
+                let shading_n = match &self.bump {
+                    None => g.shading_n,
+                    Some(bump) => self.bumped(bump, hit, &g, &texture, g.n, g.shading_n, None),
+                };
                 Interaction {
                     p: g.p,
                     p_error: g.p_error,
                     n: g.n,
-                    shading_n: g.shading_n,
-                    texture: TextureCoords {
-                        uv: g.uv,
-                        object_point: g.p,
-                    },
+                    shading_n,
+                    texture,
                     primitive,
                     hit: *hit,
                 }
@@ -159,20 +168,51 @@ impl Primitive {
                 let object_error = g.n.abs().dot(g.p_error + t.inverse_error(p))
                     + inverse_mismatch * g.n.abs().dot(Vec3::ONE);
                 let p_error = p_error + n.abs() * (object_error / stretch * (1.0 + gamma(4)));
+                let texture = TextureCoords {
+                    uv: g.uv,
+                    object_point: g.p,
+                };
+                let shading_n = t.normal(g.shading_n).normalized();
+                let shading_n = match &self.bump {
+                    None => shading_n,
+                    Some(bump) => {
+                        self.bumped(bump, &local_hit, &g, &texture, n, shading_n, Some(t))
+                    }
+                };
                 Interaction {
                     p,
                     p_error,
                     n,
-                    shading_n: t.normal(g.shading_n).normalized(),
-                    texture: TextureCoords {
-                        uv: g.uv,
-                        object_point: g.p,
-                    },
+                    shading_n,
+                    texture,
                     primitive,
                     hit: *hit,
                 }
             }
         })
+    }
+
+    /// The shading normal `shading_n` (world space) turned by `bump`, at a hit whose
+    /// object-space geometry is `g`. The tangent frame is placed in the world first, as
+    /// pbrt-v4 does.
+    #[cold]
+    #[allow(clippy::too_many_arguments)]
+    fn bumped(
+        &self,
+        bump: &Bump,
+        hit: &HitRecord,
+        g: &SurfaceGeometry,
+        texture: &TextureCoords,
+        n: Vec3,
+        shading_n: Vec3,
+        placement: Option<&Transform>,
+    ) -> Vec3 {
+        let object = self.shape.uv_derivatives(hit, g);
+        let world = match placement {
+            None => object,
+            Some(t) => object.map(|d| t.vector(d)),
+        };
+        bump.shading_normal(texture, n, shading_n, &UvDerivatives { world, object })
     }
 
     /// Some hit in (0, t_max), not necessarily the nearest (see [`Shape::intersect_any`]).

@@ -4,8 +4,10 @@
 use super::Reader;
 use crate::reader::{Result, Value};
 use plenum_core::color::Color;
-use plenum_core::material::PhongMaterial;
-use plenum_core::texture::Texture;
+use plenum_core::material::{FloatTexture, PhongMaterial};
+use plenum_core::scene::{Bitangent, Bump};
+use plenum_core::texture::{ImageTexture, Texture};
+use std::sync::Arc;
 use toml::de::DeValue;
 
 impl<'s> Reader<'s> {
@@ -28,6 +30,9 @@ impl<'s> Reader<'s> {
                     let id = self.builder.add_material(name, m);
                     if !two_sided {
                         self.builder.set_one_sided(id);
+                    }
+                    if let Some(bump) = self.bump(v)? {
+                        self.builder.set_bump(id, bump);
                     }
                     self.materials.insert(name.to_string(), id);
                     return Ok(());
@@ -99,5 +104,64 @@ impl<'s> Reader<'s> {
         let id = self.builder.add_material(name, m);
         self.materials.insert(name.to_string(), id);
         Ok(())
+    }
+
+    /// A physical material's `normal_map` (an image file of tangent-space normals, read
+    /// linear, green up the image as in glTF; x and y times `normal_scale`) or `bump`
+    /// (heights along the normal in scene units, a number or a texture, times `bump_scale`).
+    fn bump(&self, v: &Value<'s>) -> Result<Option<Bump>> {
+        let DeValue::Table(t) = v.get_ref() else {
+            return Ok(None);
+        };
+        if let Some(file) = t.get("normal_map") {
+            if let Some(b) = t.get("bump") {
+                return Err(self
+                    .src
+                    .error(b.span(), "give a `normal_map` or a `bump`, not both"));
+            }
+            let path = self.base_dir.join(self.src.string(file)?);
+            let texels = plenum_image::read_data_texture(&path)
+                .map_err(|e| self.src.error(file.span(), e.to_string()))?;
+            let rgb = texels.rgb.iter();
+            let colors = rgb.map(|p| Color::new(p[0] as f64, p[1] as f64, p[2] as f64));
+            let image =
+                ImageTexture::new(texels.width, texels.height, colors.collect(), [1.0, 1.0])
+                    .ok_or_else(|| self.src.error(file.span(), "the image is empty"))?;
+            let scale = match t.get("normal_scale") {
+                Some(s) => self.src.number(s)?,
+                None => 1.0,
+            };
+            return Ok(Some(Bump::NormalMap {
+                image: Arc::new(image),
+                scale,
+                bitangent: Bitangent::AlongV,
+            }));
+        }
+        let scale = match t.get("bump_scale") {
+            Some(s) => self.src.number(s)?,
+            None => 1.0,
+        };
+        for key in ["normal_scale", "bump_scale"] {
+            let other = if key == "normal_scale" {
+                "normal_map"
+            } else {
+                "bump"
+            };
+            if let (Some(k), None) = (t.get(key), t.get(other)) {
+                return Err(self
+                    .src
+                    .error(k.span(), format!("`{key}` without a `{other}`")));
+            }
+        }
+        Ok(match t.get("bump") {
+            None => None,
+            Some(b) => match self.texture(b)? {
+                Texture::Constant(_) => None,
+                height => Some(Bump::HeightMap {
+                    height: FloatTexture::Texture(height),
+                    scale,
+                }),
+            },
+        })
     }
 }

@@ -181,7 +181,9 @@ impl<'s> Reader<'s> {
             let f = self.src.table(
                 v,
                 "a texture",
-                &["texture", "even", "odd", "scale", "file", "channel"],
+                &[
+                    "texture", "even", "odd", "scale", "file", "channel", "encoding",
+                ],
             )?;
             let k = f.required("texture")?;
             (self.src.string(k)?.to_string(), k.span())
@@ -204,12 +206,30 @@ impl<'s> Reader<'s> {
                 let f = self.src.table(
                     v,
                     "an image texture",
-                    &["texture", "file", "scale", "channel"],
+                    &["texture", "file", "scale", "channel", "encoding"],
                 )?;
                 let file = f.required("file")?;
+                // "linear": 8-bit values as stored, for data (heights, normals).
+                let linear =
+                    match f.get("encoding") {
+                        None => false,
+                        Some(e) => match self.src.string(e)? {
+                            "srgb" => false,
+                            "linear" => true,
+                            other => return Err(self.src.error(
+                                e.span(),
+                                format!(
+                                    "unknown encoding `{other}`: expected \"srgb\" or \"linear\""
+                                ),
+                            )),
+                        },
+                    };
                 let path = self.base_dir.join(self.src.string(file)?);
-                let texels = plenum_image::read_texture(&path)
-                    .map_err(|e| self.src.error(file.span(), e.to_string()))?;
+                let texels = match linear {
+                    true => plenum_image::read_data_texture(&path),
+                    false => plenum_image::read_texture(&path),
+                }
+                .map_err(|e| self.src.error(file.span(), e.to_string()))?;
                 let scale = match f.get("scale") {
                     None => [1.0, 1.0],
                     Some(s) => {

@@ -42,8 +42,18 @@ impl<'s> Reader<'s> {
         let rough_keys = ["roughness", "remap_roughness"];
         let src = self.src;
         let table = |keys: &[&'static str]| {
-            let all: Vec<&'static str> =
-                ["type", "two_sided"].iter().chain(keys).copied().collect();
+            let all: Vec<&'static str> = [
+                "type",
+                "two_sided",
+                "normal_map",
+                "normal_scale",
+                "bump",
+                "bump_scale",
+            ]
+            .iter()
+            .chain(keys)
+            .copied()
+            .collect();
             src.table(v, &what, &all)
         };
         Ok(Some(match kind {

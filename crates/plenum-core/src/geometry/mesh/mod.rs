@@ -547,6 +547,31 @@ impl TriangleMesh {
             uv,
         }
     }
+
+    /// ∂p/∂u and ∂p/∂v across stored triangle `hit.part`, from its corners' uvs (pbrt-v4's
+    /// solution of the 2×2 system); without uvs, the map of `surface`, u and v the second
+    /// and third barycentric coordinates. Zero where the uvs are degenerate.
+    pub fn uv_derivatives(&self, hit: &HitRecord) -> [Vec3; 2] {
+        let [p0, p1, p2] = self.triangle(hit.part);
+        let idx = match self.vertex_indices(hit.part) {
+            Some(idx) if !self.uvs.is_empty() => idx,
+            _ => return [p1 - p0, p2 - p0],
+        };
+        let [t0, t1, t2] = idx.map(|i| self.uvs[i as usize]);
+        let (duv02, duv12) = (
+            [t0[0] - t2[0], t0[1] - t2[1]],
+            [t1[0] - t2[0], t1[1] - t2[1]],
+        );
+        let (dp02, dp12) = (p0 - p2, p1 - p2);
+        let det = duv02[0] * duv12[1] - duv02[1] * duv12[0];
+        if det.abs() < 1e-12 {
+            return [Vec3::ZERO; 2];
+        }
+        [
+            (dp02 * duv12[1] - dp12 * duv02[1]) / det,
+            (dp12 * duv02[0] - dp02 * duv12[0]) / det,
+        ]
+    }
 }
 
 /// Vertices and vertex indices for triangles given by their corners. With the indices the
