@@ -22,6 +22,13 @@ pub enum Texture {
         scale: f64,
     },
     Image(Arc<ImageTexture>),
+    /// Bilinear between four colours at the corners of the unit square in (u, v), repeats
+    /// of it `scale` per unit (pbrt-v4's `bilerp`): [v00, v10, v01, v11], v10 at (1, 0).
+    Bilerp(Arc<([Color; 4], [f64; 2])>),
+    /// The product of two textures, channel by channel (pbrt-v4's `scale`).
+    Scale(Arc<[Texture; 2]>),
+    /// (1 − t)·a + t·b with t the mean of the third texture's channels (pbrt-v4's `mix`).
+    Mix(Arc<[Texture; 3]>),
 }
 
 /// Where a texture is looked up.
@@ -54,6 +61,55 @@ impl Texture {
                 }
             }
             Texture::Image(image) => image.bilinear(at.uv),
+            Texture::Bilerp(b) => {
+                let ([v00, v10, v01, v11], scale) = **b;
+                let (u, v) = (at.uv[0] * scale[0], at.uv[1] * scale[1]);
+                v00 * ((1.0 - u) * (1.0 - v))
+                    + v10 * (u * (1.0 - v))
+                    + v01 * ((1.0 - u) * v)
+                    + v11 * (u * v)
+            }
+            Texture::Scale(t) => {
+                let (a, b) = (t[0].evaluate(at), t[1].evaluate(at));
+                Color::new(a.r * b.r, a.g * b.g, a.b * b.b)
+            }
+            Texture::Mix(t) => {
+                let amount = t[2].evaluate(at);
+                let w = (amount.r + amount.g + amount.b) / 3.0;
+                t[0].evaluate(at) * (1.0 - w) + t[1].evaluate(at) * w
+            }
+        }
+    }
+
+    /// Its one value, where it has the same everywhere: a constant, or a product or mix of
+    /// constants (which readers fold into one).
+    pub fn constant_value(&self) -> Option<Color> {
+        match self {
+            Texture::Constant(c) => Some(*c),
+            Texture::Scale(t) => {
+                let (a, b) = (t[0].constant_value()?, t[1].constant_value()?);
+                Some(Color::new(a.r * b.r, a.g * b.g, a.b * b.b))
+            }
+            Texture::Mix(t) => {
+                let (a, b, amount) = (
+                    t[0].constant_value()?,
+                    t[1].constant_value()?,
+                    t[2].constant_value()?,
+                );
+                let w = (amount.r + amount.g + amount.b) / 3.0;
+                Some(a * (1.0 - w) + b * w)
+            }
+            _ => None,
+        }
+    }
+
+    /// Whether the texture is looked up by (u, v) (rather than being constant or solid).
+    pub fn needs_uv(&self) -> bool {
+        match self {
+            Texture::Constant(_) | Texture::Checker3d { .. } => false,
+            Texture::Checker2d { .. } | Texture::Image(_) | Texture::Bilerp(_) => true,
+            Texture::Scale(t) => t.iter().any(Texture::needs_uv),
+            Texture::Mix(t) => t.iter().any(Texture::needs_uv),
         }
     }
 
@@ -67,6 +123,9 @@ impl Texture {
                 max(even).max(max(odd))
             }
             Texture::Image(_) => 1.0,
+            Texture::Bilerp(b) => b.0.iter().map(max).fold(0.0, f64::max),
+            Texture::Scale(t) => t[0].max_component() * t[1].max_component(),
+            Texture::Mix(t) => t[0].max_component().max(t[1].max_component()),
         }
     }
 
@@ -78,6 +137,9 @@ impl Texture {
                 even.is_black() && odd.is_black()
             }
             Texture::Image(_) => false,
+            Texture::Bilerp(b) => b.0.iter().all(|c| c.is_black()),
+            Texture::Scale(t) => t[0].is_black() || t[1].is_black(),
+            Texture::Mix(t) => t[0].is_black() && t[1].is_black(),
         }
     }
 }
@@ -175,6 +237,49 @@ mod tests {
             scale: 1.0,
         };
         assert_eq!(solid.evaluate(&at(1.5, 0.5)), Color::BLACK);
+    }
+
+    #[test]
+    fn bilerp_scale_and_mix_combine_as_pbrt_defines_them() {
+        let corners = [
+            Color::new(1.0, 0.0, 0.0),
+            Color::new(0.0, 1.0, 0.0),
+            Color::new(0.0, 0.0, 1.0),
+            Color::new(1.0, 1.0, 1.0),
+        ];
+        let bilerp = Texture::Bilerp(Arc::new((corners, [1.0, 1.0])));
+        // At (0.25, 0.5): weights ¾·½ (v00), ¼·½ (v10), ¾·½ (v01), ¼·½ (v11).
+        let c = bilerp.evaluate(&at(0.25, 0.5));
+        let want = Color::new(0.375 + 0.125, 0.125 + 0.125, 0.375 + 0.125);
+        let off = (c.r - want.r).abs() + (c.g - want.g).abs() + (c.b - want.b).abs();
+        assert!(off < 1e-12, "{c:?}");
+        assert_eq!(bilerp.evaluate(&at(1.0, 0.0)), corners[1]);
+        let checker = Texture::Checker2d {
+            even: Color::WHITE,
+            odd: Color::BLACK,
+            scale: 2.0,
+        };
+        let scaled = Texture::Scale(Arc::new([
+            checker.clone(),
+            Texture::Constant(Color::new(0.5, 0.25, 2.0)),
+        ]));
+        assert_eq!(scaled.evaluate(&at(0.1, 0.1)), Color::new(0.5, 0.25, 2.0));
+        assert_eq!(scaled.evaluate(&at(0.6, 0.1)), Color::BLACK);
+        assert!(scaled.needs_uv() && (scaled.max_component() - 2.0).abs() < 1e-12);
+        let mix = Texture::Mix(Arc::new([
+            Texture::Constant(Color::gray(0.2)),
+            Texture::Constant(Color::gray(0.6)),
+            checker,
+        ]));
+        // Amount 1 on even squares (the second), 0 on odd ones (the first).
+        assert_eq!(mix.evaluate(&at(0.1, 0.1)), Color::gray(0.6));
+        assert_eq!(mix.evaluate(&at(0.6, 0.1)), Color::gray(0.2));
+        let solid = Texture::Mix(Arc::new([
+            Texture::Constant(Color::BLACK),
+            Texture::Constant(Color::BLACK),
+            Texture::Constant(Color::gray(0.5)),
+        ]));
+        assert!(solid.is_black() && !solid.needs_uv());
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! as GGX α without remapping, and `max_depth` M as Plenum's M − 2. Whatever has no
 //! counterpart, and every property that is never read, gets a located warning.
 
+mod serialized;
 mod xml;
 
 use crate::diagnostics::{did_you_mean, SceneError};
@@ -1062,17 +1063,57 @@ impl<'d> Builder<'d> {
                     self.doc
                         .error(loc, format!("cannot read the mesh: {}", e.message))
                 })?;
-                if self.boolean(o, "face_normals", false)? {
-                    let l = self.prop(o, "face_normals").unwrap().loc.clone();
-                    self.warn(
-                        &l,
-                        "`face_normals` is not supported: the mesh's own normals are used",
-                    );
-                }
                 if !self.boolean(o, "flip_tex_coords", true)? {
                     let l = self.prop(o, "flip_tex_coords").unwrap().loc.clone();
                     self.warn(&l, "`flip_tex_coords = false` is not supported: textures are looked up with v up");
                 }
+                // Mitsuba shades a mesh smoothly: its own normals, or ones it computes, or
+                // with `face_normals` none at all.
+                let face_normals = self.boolean(o, "face_normals", false)?;
+                let mesh = match (face_normals, mesh.normals().is_empty()) {
+                    (false, false) => mesh,
+                    (true, true) => mesh,
+                    (flat, _) => {
+                        let (positions, triangles) = mesh.indexed();
+                        let normals = match flat {
+                            true => Vec::new(),
+                            false => angle_weighted_normals(&positions, &triangles),
+                        };
+                        let uvs = mesh.uvs().to_vec();
+                        TriangleMesh::new(positions, triangles, normals, uvs)
+                            .map_err(|e| self.doc.error(loc, e.to_string()))?
+                    }
+                };
+                Shape::Mesh(Arc::new(mesh))
+            }
+            "serialized" => {
+                flip_unsupported(self);
+                let (file, loc) = self.string(o, "filename")?.ok_or_else(|| {
+                    self.doc
+                        .error(&ob.loc, "a serialized shape needs a `filename`")
+                })?;
+                let path = self.doc.base_dir(loc.file).join(file);
+                let index = self.integer(o, "shape_index", 0)?;
+                let index = u32::try_from(index).map_err(|_| {
+                    let p = self.prop(o, "shape_index").unwrap();
+                    self.doc
+                        .error(&p.loc, format!("expected a shape_index ≥ 0, found {index}"))
+                })?;
+                let bytes = std::fs::read(&path)
+                    .map_err(|e| self.doc.error(loc, format!("cannot read the mesh: {e}")))?;
+                let m = serialized::parse(&bytes, index)
+                    .map_err(|e| self.doc.error(loc, format!("{}: {e}", path.display())))?;
+                let face_normals = self.boolean(o, "face_normals", false)? || m.face_normals;
+                // Mitsuba shades a mesh without normals smoothly, unless told otherwise.
+                let normals = match (face_normals, m.normals.is_empty()) {
+                    (true, _) => Vec::new(),
+                    (false, true) => angle_weighted_normals(&m.positions, &m.triangles),
+                    (false, false) => m.normals,
+                };
+                // Mitsuba's v runs down the image, Plenum's up.
+                let uvs = m.uvs.iter().map(|&[u, v]| [u, 1.0 - v]).collect();
+                let mesh = TriangleMesh::new(m.positions, m.triangles, normals, uvs)
+                    .map_err(|e| self.doc.error(loc, format!("{}: {e}", path.display())))?;
                 Shape::Mesh(Arc::new(mesh))
             }
             other => {
@@ -1681,6 +1722,35 @@ trait WithSpectrum: Sized {
 
 impl WithSpectrum for Light {}
 
+/// Per-vertex normals as Mitsuba computes them for a mesh that has none: each triangle's
+/// normal weighted by its angle at the vertex (Thürmer and Wüthrich 1998).
+fn angle_weighted_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for t in triangles {
+        let p = t.map(|i| positions[i as usize]);
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        if n.length_squared() == 0.0 {
+            continue;
+        }
+        let n = n.normalized();
+        for k in 0..3 {
+            let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+            let cos = a.dot(b) / (a.length() * b.length());
+            normals[t[k] as usize] += n * cos.clamp(-1.0, 1.0).acos();
+        }
+    }
+    normals
+        .into_iter()
+        .map(|n| {
+            if n.length_squared() > 0.0 {
+                n.normalized()
+            } else {
+                n
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1698,5 +1768,80 @@ mod tests {
         // The diagonal of a square is √2 times its side.
         let d = vertical_fov(90.0, "diagonal", 100, 100);
         assert!(((0.5 * d).to_radians().tan() - 1.0 / 2f64.sqrt()).abs() < 1e-12);
+    }
+    #[test]
+    fn serialized_meshes_are_read_by_index_with_mitsubas_uv_and_normals() {
+        // Two squares in one file; the second, at z = 2.5, with (u, v) = (x, y) in Mitsuba's
+        // convention, so Plenum's v is 1 − y. Without normals in the file, Mitsuba's
+        // smooth ones are computed (a flat square: +z); `face_normals` keeps it flat.
+        let square = |z: f64| {
+            (
+                vec![[0.0, 0.0, z], [1.0, 0.0, z], [1.0, 1.0, z], [0.0, 1.0, z]],
+                vec![[0, 1, 2], [0, 2, 3]],
+                vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+            )
+        };
+        let file = serialized::tests::write(&[square(0.0), square(2.5)], false, 4);
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("two.serialized"), &file).unwrap();
+        let scene = |shape: &str| {
+            let text = format!(
+                r#"<scene version="3.0.0"><emitter type="constant"/>
+<shape type="serialized">{shape}</shape>
+</scene>"#
+            );
+            std::fs::write(dir.path().join("scene.xml"), text).unwrap();
+            crate::load_scene(&dir.path().join("scene.xml"))
+        };
+        let l = scene(
+            r#"<string name="filename" value="two.serialized"/><integer name="shape_index" value="1"/>"#,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        let Shape::Mesh(m) = &l.scene.geometry.primitives[0].shape else {
+            panic!("expected a mesh");
+        };
+        let (positions, _) = m.indexed();
+        assert!(positions.iter().all(|p| p.z == 2.5), "{positions:?}");
+        assert_eq!(m.uvs()[2], [1.0, 0.0]);
+        assert!(
+            m.normals().iter().all(|n| *n == Vec3::Z),
+            "{:?}",
+            m.normals()
+        );
+        let flat = scene(
+            r#"<string name="filename" value="two.serialized"/><boolean name="face_normals" value="true"/>"#,
+        )
+        .unwrap();
+        let Shape::Mesh(m) = &flat.scene.geometry.primitives[0].shape else {
+            panic!("expected a mesh");
+        };
+        assert!(m.normals().is_empty());
+        // A shape_index beyond the file, and a damaged file: located errors.
+        let error = |shape: &str| match scene(shape) {
+            Ok(_) => panic!("expected an error"),
+            Err(e) => e,
+        };
+        let e = error(
+            r#"<string name="filename" value="two.serialized"/><integer name="shape_index" value="2"/>"#,
+        );
+        assert!(
+            e.to_string().contains("holds 2 meshes") && e.to_string().contains(":2:"),
+            "{e}"
+        );
+        std::fs::write(dir.path().join("bad.serialized"), &file[..20]).unwrap();
+        let e = error(r#"<string name="filename" value="bad.serialized"/>"#);
+        assert!(e.to_string().contains("mesh's stream"), "{e}");
+    }
+
+    #[test]
+    fn normals_are_weighted_by_angle() {
+        // A corner of a cube: three faces meeting at the origin, each with a right angle
+        // there, give the normal along (−1, −1, −1)/√3 at the corner.
+        let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+        let triangles = vec![[0, 2, 1], [0, 1, 3], [0, 3, 2]];
+        let n = angle_weighted_normals(&positions, &triangles);
+        let want = Vec3::new(-1.0, -1.0, -1.0).normalized();
+        assert!((n[0] - want).length() < 1e-12, "{:?}", n[0]);
+        assert!((n[1] - Vec3::new(0.0, -1.0, -1.0).normalized()).length() < 1e-12);
     }
 }

@@ -1750,36 +1750,53 @@ impl Parser {
                 }
             }
             "scale" | "mix" => {
-                let a = constant(self, "tex", 1.0)?;
-                let s = constant(self, "scale", 1.0)?;
-                let result = if ty == "scale" {
-                    match (a, s) {
-                        (Some(a), Some(s)) => Some(Color::new(a.r * s.r, a.g * s.g, a.b * s.b)),
-                        _ => None,
-                    }
-                } else {
-                    let (t1, t2) = (constant(self, "tex1", 0.0)?, constant(self, "tex2", 1.0)?);
-                    let amount = self.float(p, "amount", 0.5)?;
-                    match (t1, t2) {
-                        (Some(x), Some(y)) => Some(x * (1.0 - amount) + y * amount),
-                        _ => None,
+                // An operand: a texture by name, or a value (a constant texture).
+                let operand = |s: &Self, key: &str, default: f64| -> Result<Texture> {
+                    match p.get(key) {
+                        Some(q) if q.ty == "texture" => s.texture_ref(q),
+                        _ => Ok(Texture::Constant(
+                            constant(s, key, default)?.unwrap_or(Color::gray(default)),
+                        )),
                     }
                 };
-                match result {
-                    Some(c) => Texture::Constant(c),
-                    None => {
-                        // Keep the textured operand, unscaled.
-                        let key = if ty == "scale" { "tex" } else { "tex1" };
-                        self.warn(
+                let (a, b, amount) = match ty {
+                    "scale" => (
+                        operand(self, "tex", 1.0)?,
+                        operand(self, "scale", 1.0)?,
+                        None,
+                    ),
+                    _ => (
+                        operand(self, "tex1", 0.0)?,
+                        operand(self, "tex2", 1.0)?,
+                        Some(operand(self, "amount", 0.5)?),
+                    ),
+                };
+                let combined = match amount {
+                    None => Texture::Scale(Arc::new([a, b])),
+                    Some(amount) => Texture::Mix(Arc::new([a, b, amount])),
+                };
+                // Constants are combined here, once.
+                combined
+                    .constant_value()
+                    .map_or(combined, Texture::Constant)
+            }
+            "bilerp" => {
+                let scale = mapping(self)?;
+                let corner = |s: &Self, key: &str, default: f64| -> Result<Color> {
+                    constant(s, key, default)?.ok_or_else(|| {
+                        s.error(
                             loc,
-                            format!("a {ty} of textures is not supported: using `{key}` alone"),
-                        );
-                        match p.get(key) {
-                            Some(q) if q.ty == "texture" => self.texture_ref(q)?,
-                            _ => Texture::Constant(Color::gray(0.5)),
-                        }
-                    }
-                }
+                            format!("expected `{key}` to be a value, not a texture"),
+                        )
+                    })
+                };
+                let corners = [
+                    corner(self, "v00", 0.0)?,
+                    corner(self, "v10", 0.0)?,
+                    corner(self, "v01", 1.0)?,
+                    corner(self, "v11", 1.0)?,
+                ];
+                Texture::Bilerp(Arc::new((corners, scale)))
             }
             other => {
                 self.warn(

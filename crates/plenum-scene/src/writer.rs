@@ -637,6 +637,18 @@ fn matrix(t: &Transform) -> String {
 
 fn texture(t: &Texture) -> String {
     match t {
+        Texture::Image(img) => format!(
+            "{}  # an image texture, written as its average colour",
+            color(img.average())
+        ),
+        t => inline_texture(t),
+    }
+}
+
+/// A texture as one TOML value, without a comment (it may sit inside another); an image as
+/// its average colour.
+fn inline_texture(t: &Texture) -> String {
+    match t {
         Texture::Constant(c) => color(*c),
         Texture::Checker2d { even, odd, scale } => format!(
             "{{ texture = \"checker\", even = {}, odd = {}, scale = {scale:?} }}",
@@ -648,9 +660,27 @@ fn texture(t: &Texture) -> String {
             color(*even),
             color(*odd)
         ),
-        Texture::Image(img) => format!(
-            "{}  # an image texture, written as its average colour",
-            color(img.average())
+        Texture::Image(img) => color(img.average()),
+        Texture::Bilerp(b) => {
+            let (corners, scale) = &**b;
+            let corners: Vec<String> = corners.iter().map(|c| color(*c)).collect();
+            format!(
+                "{{ texture = \"bilerp\", corners = [{}], scale = [{:?}, {:?}] }}",
+                corners.join(", "),
+                scale[0],
+                scale[1]
+            )
+        }
+        Texture::Scale(t) => format!(
+            "{{ texture = \"scale\", textures = [{}, {}] }}",
+            inline_texture(&t[0]),
+            inline_texture(&t[1])
+        ),
+        Texture::Mix(t) => format!(
+            "{{ texture = \"mix\", textures = [{}, {}], amount = {} }}",
+            inline_texture(&t[0]),
+            inline_texture(&t[1]),
+            inline_texture(&t[2])
         ),
     }
 }

@@ -393,7 +393,7 @@ fn what_plenum_lacks_is_warned_where_it_is_written() {
             <float name="sparkle" value="1"/>
         </shape>
         <medium type="homogeneous" id="fog"/>
-        <shape type="serialized"><string name="filename" value="x.serialized"/></shape>"#));
+        <shape type="bsplinecurve"><string name="filename" value="x.txt"/></shape>"#));
     let all = l.warnings.join("\n");
     assert_eq!(l.warnings.len(), 4, "{all}");
     assert!(all.contains(":4:13") && all.contains("Beckmann"), "{all}");
@@ -406,7 +406,7 @@ fn what_plenum_lacks_is_warned_where_it_is_written() {
         "{all}"
     );
     assert!(
-        all.contains(":8:9") && all.contains("`serialized` shape is not supported"),
+        all.contains(":8:9") && all.contains("`bsplinecurve` shape is not supported"),
         "{all}"
     );
 }

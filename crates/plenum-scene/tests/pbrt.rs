@@ -766,3 +766,66 @@ Shape "trianglemesh" "point3 P" [ -5 -5 5  -5 5 5  5 5 5  5 -5 5 ]
         l.warnings
     );
 }
+
+#[test]
+fn scale_mix_and_bilerp_textures_combine_textures() {
+    use plenum_core::material::{FloatTexture, Material};
+    use plenum_core::math::Vec3;
+    use plenum_core::texture::TextureCoords;
+    let text = r#"WorldBegin
+LightSource "point" "rgb I" [ 1 1 1 ]
+Texture "checks" "spectrum" "checkerboard" "float uscale" 2 "float vscale" 2 "rgb tex1" [ 1 1 1 ] "rgb tex2" [ 0 0 0 ]
+Texture "ramp" "spectrum" "bilerp" "rgb v00" [ 0 0 0 ] "rgb v10" [ 1 0 0 ] "rgb v01" [ 0 1 0 ] "rgb v11" [ 1 1 0 ]
+Texture "dim" "spectrum" "scale" "texture tex" "checks" "float scale" 0.5
+Texture "blend" "spectrum" "mix" "texture tex1" "ramp" "rgb tex2" [ 0 0 1 ] "texture amount" "checks"
+Texture "quarter" "float" "scale" "float tex" 0.5 "float scale" 0.5
+Material "diffuse" "texture reflectance" "dim"
+Shape "sphere"
+Material "diffuse" "texture reflectance" "blend"
+Shape "sphere"
+Material "conductor" "texture roughness" "quarter"
+Shape "sphere"
+"#;
+    let at = |u: f64, v: f64| TextureCoords {
+        uv: [u, v],
+        object_point: Vec3::ZERO,
+    };
+    let check = |l: &LoadedScene, what: &str| {
+        let material =
+            |i: usize| &l.scene.materials[l.scene.geometry.primitives[i].material as usize];
+        let reflectance = |i: usize, u: f64, v: f64| match material(i) {
+            Material::Diffuse(d) => d.reflectance.rgb(&at(u, v)),
+            m => panic!("{what}: expected a diffuse material, found {m:?}"),
+        };
+        let rgb = |c: plenum_core::color::Color| [c.r, c.g, c.b];
+        let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 1e-12);
+        // The checkerboard's tex1 (white) where ⌊2u⌋ + ⌊2v⌋ is even, scaled by ½.
+        assert!(close(rgb(reflectance(0, 0.1, 0.1)), [0.5; 3]), "{what}");
+        assert!(close(rgb(reflectance(0, 0.6, 0.1)), [0.0; 3]), "{what}");
+        // Amount 1 (white squares): tex2, blue; amount 0: the bilinear ramp, at (0.6, 0.1)
+        // (0.6·0.9 + 0.6·0.1, 0.4·0.1 + 0.6·0.1, 0).
+        assert!(
+            close(rgb(reflectance(1, 0.1, 0.1)), [0.0, 0.0, 1.0]),
+            "{what}"
+        );
+        let got = rgb(reflectance(1, 0.6, 0.1));
+        assert!(close(got, [0.6, 0.1, 0.0]), "{what}: {got:?}");
+        // A scale of constants is one constant.
+        match material(2) {
+            Material::Conductor(c) => {
+                assert!(
+                    matches!(c.roughness.u, FloatTexture::Constant(a) if (a - 0.25).abs() < 1e-12)
+                )
+            }
+            m => panic!("{what}: expected a conductor, found {m:?}"),
+        }
+    };
+    let l = load(text);
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    check(&l, "pbrt");
+    // `plenum convert` writes them as the native format's textures, which read back alike.
+    let written = plenum_scene::to_toml(&l.scene, &l.defaults);
+    assert!(written.contains("texture = \"mix\"") && written.contains("texture = \"bilerp\""));
+    let back = load_files(&[("scene.toml", written.as_bytes())]).unwrap_or_else(|e| panic!("{e}"));
+    check(&back, "native");
+}

@@ -129,6 +129,8 @@ pub enum Emitter {
     /// Triangles, picked in proportion to their area.
     Triangles {
         triangles: Vec<[Vec3; 3]>,
+        /// Each triangle's unit normal, by its winding: worked out once, not per sample.
+        normals: Vec<Vec3>,
         /// Running sums of the triangles' areas, the last one the total.
         cumulative_area: Vec<f64>,
     },
@@ -249,8 +251,13 @@ impl Emitter {
                 sum
             })
             .collect();
+        let normals = triangles
+            .iter()
+            .map(|[a, b, c]| (*b - *a).cross(*c - *a).normalized())
+            .collect();
         (sum > 0.0).then_some(Emitter::Triangles {
             triangles,
+            normals,
             cumulative_area,
         })
     }
@@ -314,6 +321,7 @@ impl Emitter {
             }
             Emitter::Triangles {
                 triangles,
+                normals,
                 cumulative_area,
             } => {
                 let total = *cumulative_area.last()?;
@@ -327,8 +335,7 @@ impl Emitter {
                 let u0 = ((target - below) / width).clamp(0.0, 1.0 - f64::EPSILON);
                 let [a, b, c] = triangles[i];
                 let (b0, b1) = uniform_triangle([u0, u[1]]);
-                let n = (b - a).cross(c - a).normalized();
-                (a * b0 + b * b1 + c * (1.0 - b0 - b1), n)
+                (a * b0 + b * b1 + c * (1.0 - b0 - b1), normals[i])
             }
         })
     }

@@ -167,13 +167,10 @@ impl SpectralTexture {
     }
 
     pub fn needs_uv(&self) -> bool {
-        matches!(
-            self,
-            SpectralTexture::Rgb {
-                texture: Texture::Checker2d { .. } | Texture::Image(_),
-                ..
-            }
-        )
+        match self {
+            SpectralTexture::Constant(_) => false,
+            SpectralTexture::Rgb { texture, .. } => texture.needs_uv(),
+        }
     }
 
     /// The same value at every wavelength, so that a dielectric of this η does not disperse.
@@ -300,9 +297,9 @@ impl FloatTexture {
     }
 
     pub fn needs_uv(&self) -> bool {
-        matches!(
-            self,
-            FloatTexture::Texture(Texture::Checker2d { .. } | Texture::Image(_))
-        )
+        match self {
+            FloatTexture::Constant(_) => false,
+            FloatTexture::Texture(t) => t.needs_uv(),
+        }
     }
 }

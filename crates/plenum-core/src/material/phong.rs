@@ -164,7 +164,7 @@ impl PhongMaterial {
             &self.transmissive,
         ]
         .iter()
-        .any(|t| matches!(t, Texture::Checker2d { .. } | Texture::Image(_)))
+        .any(|t| t.needs_uv())
     }
 
     /// Light can pass through: shadow rays continue and rays may start inside.

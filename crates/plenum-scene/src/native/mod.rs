@@ -182,7 +182,8 @@ impl<'s> Reader<'s> {
                 v,
                 "a texture",
                 &[
-                    "texture", "even", "odd", "scale", "file", "channel", "encoding",
+                    "texture", "even", "odd", "scale", "file", "channel", "encoding", "corners",
+                    "textures", "amount",
                 ],
             )?;
             let k = f.required("texture")?;
@@ -210,20 +211,21 @@ impl<'s> Reader<'s> {
                 )?;
                 let file = f.required("file")?;
                 // "linear": 8-bit values as stored, for data (heights, normals).
-                let linear =
-                    match f.get("encoding") {
-                        None => false,
-                        Some(e) => match self.src.string(e)? {
-                            "srgb" => false,
-                            "linear" => true,
-                            other => return Err(self.src.error(
+                let linear = match f.get("encoding") {
+                    None => false,
+                    Some(e) => match self.src.string(e)? {
+                        "srgb" => false,
+                        "linear" => true,
+                        other => {
+                            return Err(self.src.error(
                                 e.span(),
                                 format!(
                                     "unknown encoding `{other}`: expected \"srgb\" or \"linear\""
                                 ),
-                            )),
-                        },
-                    };
+                            ))
+                        }
+                    },
+                };
                 let path = self.base_dir.join(self.src.string(file)?);
                 let texels = match linear {
                     true => plenum_image::read_data_texture(&path),
@@ -270,14 +272,67 @@ impl<'s> Reader<'s> {
                     .ok_or_else(|| self.src.error(file.span(), "the image is empty"))?;
                 Ok(Texture::Image(Arc::new(image)))
             }
+            "bilerp" => {
+                let f = self
+                    .src
+                    .table(v, "a bilerp texture", &["texture", "corners", "scale"])?;
+                let corners = f.required("corners")?;
+                let list = self
+                    .src
+                    .array(corners, "four colours [c00, c10, c01, c11]")?;
+                let [c00, c10, c01, c11] = list else {
+                    return Err(self.src.error(
+                        corners.span(),
+                        format!(
+                            "expected four colours [c00, c10, c01, c11], found {}",
+                            list.len()
+                        ),
+                    ));
+                };
+                let corners = [c00, c10, c01, c11].map(|c| self.color(c));
+                let [c00, c10, c01, c11] = corners;
+                let scale = match f.get("scale") {
+                    None => [1.0, 1.0],
+                    Some(s) => self.src.numbers::<2>(s, "[u, v] repeats")?,
+                };
+                Ok(Texture::Bilerp(Arc::new(([c00?, c10?, c01?, c11?], scale))))
+            }
+            "scale" | "mix" => {
+                let keys: &[&str] = match kind.0.as_str() {
+                    "scale" => &["texture", "textures"],
+                    _ => &["texture", "textures", "amount"],
+                };
+                let f = self.src.table(v, "a texture", keys)?;
+                let textures = f.required("textures")?;
+                let list = self.src.array(textures, "two textures or colours")?;
+                let [a, b] = list else {
+                    return Err(self.src.error(
+                        textures.span(),
+                        format!("expected two textures or colours, found {}", list.len()),
+                    ));
+                };
+                let (a, b) = (self.texture(a)?, self.texture(b)?);
+                let combined = match kind.0.as_str() {
+                    "scale" => Texture::Scale(Arc::new([a, b])),
+                    _ => {
+                        let amount = match f.get("amount") {
+                            None => Texture::Constant(Color::gray(0.5)),
+                            Some(t) => self.texture(t)?,
+                        };
+                        Texture::Mix(Arc::new([a, b, amount]))
+                    }
+                };
+                Ok(combined
+                    .constant_value()
+                    .map_or(combined, Texture::Constant))
+            }
             other => {
                 let e = self.src.error(kind.1, format!("unknown texture `{other}`"));
-                Err(
-                    match did_you_mean(other, ["checker", "checker3d", "image"]) {
-                        Some(s) => e.with_help(format!("did you mean `{s}`?")),
-                        None => e.with_help("expected one of: checker, checker3d, image"),
-                    },
-                )
+                let kinds = ["checker", "checker3d", "image", "bilerp", "scale", "mix"];
+                Err(match did_you_mean(other, kinds) {
+                    Some(s) => e.with_help(format!("did you mean `{s}`?")),
+                    None => e.with_help(format!("expected one of: {}", kinds.join(", "))),
+                })
             }
         }
     }
