@@ -144,7 +144,8 @@ impl Texture {
     }
 }
 
-/// An image in linear RGB, repeated over (u, v) with (0, 0) at the bottom-left corner.
+/// An image in linear RGB over (u, v), (0, 0) at its bottom-left corner, repeated (or
+/// otherwise continued, see [`Wrap`]) beyond [0, 1].
 #[derive(Clone, Debug)]
 pub struct ImageTexture {
     width: usize,
@@ -156,6 +157,44 @@ pub struct ImageTexture {
     /// An affine map of (u, v) applied before `scale` (rows: u′ = m[0]·(u, v, 1), v′ =
     /// m[1]·(u, v, 1)): an atlas's region, turned (glTF's `KHR_texture_transform`).
     uv_transform: Option<Box<[[f64; 3]; 2]>>,
+    /// What lies beyond the image's edges, along u and along v.
+    wrap: [Wrap; 2],
+}
+
+/// What an image shows outside [0, 1] (the formats' wrap modes).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Wrap {
+    /// The image again (pbrt's and Mitsuba's default, glTF's `REPEAT`).
+    #[default]
+    Repeat,
+    /// The edge texel (glTF's `CLAMP_TO_EDGE`, pbrt's and Mitsuba's `clamp`).
+    Clamp,
+    /// The image reflected, every other copy (glTF's `MIRRORED_REPEAT`, Mitsuba's `mirror`).
+    Mirror,
+    /// Black (pbrt's `black`).
+    Black,
+}
+
+impl Wrap {
+    /// The texel index `i` of a row or column of `n` stands for; `None`: black.
+    #[inline]
+    fn index(self, i: i64, n: usize) -> Option<usize> {
+        let n = n as i64;
+        Some(match self {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::Clamp => i.clamp(0, n - 1),
+            Wrap::Mirror => {
+                let k = i.rem_euclid(2 * n);
+                if k < n {
+                    k
+                } else {
+                    2 * n - 1 - k
+                }
+            }
+            Wrap::Black if (0..n).contains(&i) => i,
+            Wrap::Black => return None,
+        } as usize)
+    }
 }
 
 impl ImageTexture {
@@ -167,7 +206,14 @@ impl ImageTexture {
             texels,
             scale,
             uv_transform: None,
+            wrap: [Wrap::Repeat; 2],
         })
+    }
+
+    /// The image with `wrap` beyond its edges along u and along v.
+    pub fn with_wrap(mut self, wrap: [Wrap; 2]) -> Self {
+        self.wrap = wrap;
+        self
     }
 
     /// The image looked up at (u, v) mapped by the affine `m` first (see `uv_transform`).
@@ -184,9 +230,13 @@ impl ImageTexture {
     }
 
     fn texel(&self, x: i64, y: i64) -> Color {
-        let x = x.rem_euclid(self.width as i64) as usize;
-        let y = y.rem_euclid(self.height as i64) as usize;
-        self.texels[y * self.width + x]
+        match (
+            self.wrap[0].index(x, self.width),
+            self.wrap[1].index(y, self.height),
+        ) {
+            (Some(x), Some(y)) => self.texels[y * self.width + x],
+            _ => Color::BLACK,
+        }
     }
 
     /// Bilinear interpolation between the four nearest texel centres, wrapping at the edges.
@@ -280,6 +330,42 @@ mod tests {
             Texture::Constant(Color::gray(0.5)),
         ]));
         assert!(solid.is_black() && !solid.needs_uv());
+    }
+
+    #[test]
+    fn wrap_modes_continue_the_image_past_its_edges() {
+        // Four texels in a row, values 1, 2, 3, 4 (one row: v plays no part).
+        let row: Vec<Color> = (1..=4).map(|i| Color::gray(i as f64)).collect();
+        let image = |wrap| {
+            ImageTexture::new(4, 1, row.clone(), [1.0, 1.0])
+                .unwrap()
+                .with_wrap([wrap, wrap])
+        };
+        // Texel centres at u = 0.125 + k/4: k = −1 and k = 4, 5 lie outside.
+        let at = |img: &ImageTexture, k: f64| img.bilinear([0.125 + k / 4.0, 0.5]).r;
+        let repeat = image(Wrap::Repeat);
+        assert_eq!(
+            [at(&repeat, -1.0), at(&repeat, 4.0), at(&repeat, 5.0)],
+            [4.0, 1.0, 2.0]
+        );
+        let clamp = image(Wrap::Clamp);
+        assert_eq!(
+            [at(&clamp, -1.0), at(&clamp, 4.0), at(&clamp, 5.0)],
+            [1.0, 4.0, 4.0]
+        );
+        let mirror = image(Wrap::Mirror);
+        assert_eq!(
+            [at(&mirror, -1.0), at(&mirror, 4.0), at(&mirror, 5.0)],
+            [1.0, 4.0, 3.0]
+        );
+        let black = image(Wrap::Black);
+        assert_eq!(
+            [at(&black, -1.0), at(&black, 4.0), at(&black, 1.0)],
+            [0.0, 0.0, 2.0]
+        );
+        // Halfway from the last texel to beyond it: repeat blends 4 with 1, clamp keeps 4.
+        assert!((at(&repeat, 3.5) - 2.5).abs() < 1e-12);
+        assert!((at(&clamp, 3.5) - 4.0).abs() < 1e-12);
     }
 
     #[test]

@@ -21,7 +21,7 @@ use plenum_core::material::{
 };
 use plenum_core::math::{Bounds3, Matrix4, Transform, Vec3};
 use plenum_core::scene::{Alpha, Bitangent, Bump, MaterialId, SceneBuilder};
-use plenum_core::texture::{ImageTexture, Texture};
+use plenum_core::texture::{ImageTexture, Texture, Wrap};
 use plenum_spectrum::Spectrum;
 use std::collections::HashMap;
 use std::path::Path;
@@ -161,6 +161,8 @@ struct Decoded {
     texels: plenum_image::Texels,
     at: String,
     uv_transform: Option<[[f64; 3]; 2]>,
+    /// The sampler's wrapping along u and v.
+    wrap: [Wrap; 2],
 }
 
 /// What a glTF material becomes: Plenum's material, the emission, the cut-out.
@@ -496,13 +498,11 @@ impl<'a> Reader<'a> {
             [[a, -b, b + c0], [-d, e, 1.0 - e - f]]
         });
         let sampler = texture.sampler();
-        if sampler.wrap_s() != gltf::texture::WrappingMode::Repeat
-            || sampler.wrap_t() != gltf::texture::WrappingMode::Repeat
-        {
-            self.warn(format!(
-                "{at}: only the repeat wrapping mode is supported: repeating"
-            ));
-        }
+        let wrap = [sampler.wrap_s(), sampler.wrap_t()].map(|w| match w {
+            gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+            gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+            gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
+        });
         let image = texture.source();
         let iat = format!("images[{}]", image.index());
         let decode = match colour {
@@ -531,6 +531,7 @@ impl<'a> Reader<'a> {
             texels,
             at: iat,
             uv_transform,
+            wrap,
         })
     }
 
@@ -544,6 +545,7 @@ impl<'a> Reader<'a> {
         let colors = (0..d.texels.rgb.len()).map(value).collect();
         let mut image = ImageTexture::new(d.texels.width, d.texels.height, colors, [1.0, 1.0])
             .ok_or_else(|| self.error(&d.at, "the image is empty"))?;
+        image = image.with_wrap(d.wrap);
         if let Some(m) = d.uv_transform {
             image = image.with_uv_transform(m);
         }

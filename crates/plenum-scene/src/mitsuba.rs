@@ -23,7 +23,7 @@ use plenum_core::material::{
 use plenum_core::math::{Transform, Vec3};
 use plenum_core::sampling::{FilterKind, SamplerKind};
 use plenum_core::scene::{Alpha, Bitangent, Bump, MaterialId, SceneBuilder};
-use plenum_core::texture::{ImageTexture, Texture};
+use plenum_core::texture::{ImageTexture, Texture, Wrap};
 use plenum_spectrum::Spectrum;
 use std::collections::HashMap;
 use std::path::Path;
@@ -370,13 +370,25 @@ impl<'d> Builder<'d> {
                     false => plenum_image::read_texture(&path),
                 }
                 .map_err(|e| self.doc.error(floc, e.to_string()))?;
-                for (key, default) in [("filter_type", "bilinear"), ("wrap_mode", "repeat")] {
-                    if let Some((v, l)) = self.string(t, key)? {
-                        if v != default {
-                            self.warn(l, format!("{key} `{v}` is not supported: using {default}"));
-                        }
+                if let Some((v, l)) = self.string(t, "filter_type")? {
+                    if v != "bilinear" {
+                        self.warn(
+                            l,
+                            format!("filter_type `{v}` is not supported: using bilinear"),
+                        );
                     }
                 }
+                let wrap = match self.string(t, "wrap_mode")? {
+                    None | Some(("repeat", _)) => Wrap::Repeat,
+                    Some(("mirror", _)) => Wrap::Mirror,
+                    Some(("clamp", _)) => Wrap::Clamp,
+                    Some((v, l)) => {
+                        return Err(self.doc.error(
+                            l,
+                            format!("unknown wrap_mode `{v}`: expected repeat, mirror or clamp"),
+                        ))
+                    }
+                };
                 let (width, height) = (texels.width, texels.height);
                 let texels = texels
                     .rgb
@@ -385,7 +397,7 @@ impl<'d> Builder<'d> {
                     .collect();
                 let image = ImageTexture::new(width, height, texels, scale)
                     .ok_or_else(|| self.doc.error(floc, "the image is empty"))?;
-                Ok(Texture::Image(Arc::new(image)))
+                Ok(Texture::Image(Arc::new(image.with_wrap([wrap; 2]))))
             }
             "checkerboard" => {
                 // Mitsuba: color0 where u and v are on the same side of ½ in each unit

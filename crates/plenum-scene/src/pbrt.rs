@@ -22,7 +22,7 @@ use plenum_core::material::{
 use plenum_core::math::{Matrix4, Transform, Vec3};
 use plenum_core::sampling::{FilterKind, SamplerKind};
 use plenum_core::scene::{Alpha, Bitangent, Bump, MaterialId, SceneBuilder};
-use plenum_core::texture::{ImageTexture, Texture};
+use plenum_core::texture::{ImageTexture, Texture, Wrap};
 use plenum_spectrum::Spectrum;
 use std::cell::Cell;
 use std::collections::HashMap;
@@ -1679,11 +1679,21 @@ impl Parser {
                         ),
                     }
                 }
-                if let Some((w, l)) = self.string(p, "wrap")? {
-                    if w != "repeat" {
-                        self.warn(&l, format!("wrap `{w}` is not supported: repeating"));
+                let wrap = match self.string(p, "wrap")? {
+                    None | Some(("repeat", _)) => Wrap::Repeat,
+                    Some(("black", _)) => Wrap::Black,
+                    Some(("clamp", _)) => Wrap::Clamp,
+                    Some(("octahedralsphere", l)) => {
+                        self.warn(&l, "wrap `octahedralsphere` is not supported: repeating");
+                        Wrap::Repeat
                     }
-                }
+                    Some((w, l)) => return Err(self.error(
+                        &l,
+                        format!(
+                            "unknown wrap `{w}`: expected repeat, black, clamp or octahedralsphere"
+                        ),
+                    )),
+                };
                 let read = if linear {
                     plenum_image::read_data_texture(&path)
                 } else {
@@ -1705,7 +1715,7 @@ impl Parser {
                             })
                             .collect();
                         match ImageTexture::new(width, height, texels, scale_uv) {
-                            Some(i) => Texture::Image(Arc::new(i)),
+                            Some(i) => Texture::Image(Arc::new(i.with_wrap([wrap; 2]))),
                             None => return Err(self.error(&floc, "the image is empty")),
                         }
                     }

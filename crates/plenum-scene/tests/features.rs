@@ -518,3 +518,60 @@ fn an_orthographic_camera_sees_sizes_at_any_distance_alike() {
         assert!(e.contains(says) && e.contains("bad.toml:"), "{e}");
     }
 }
+
+/// An image's `wrap` continues it past its edges, one mode for both axes or one for each;
+/// an unknown mode is a located error.
+#[test]
+fn image_wrap_modes_in_the_native_format() {
+    use plenum_core::material::Material;
+    use plenum_core::texture::TextureCoords;
+    let tmp = temp_dir("wrap");
+    let dir = tmp.path();
+    plenum_image::write_image(&dir.join("two.png"), 2, 1, &[[0.2; 3], [0.8; 3]], 0.0).unwrap();
+    let scene = |wrap: &str| {
+        format!(
+            r#"[materials.m]
+diffuse = {{ texture = "image", file = "two.png", wrap = {wrap} }}
+[[objects]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 1
+material = "m"
+"#
+        )
+    };
+    // u = −0.25 and 1.25: the centres of the texels just outside; v = 1.5 outside too.
+    for (wrap, want) in [
+        (r#""repeat""#, [0.8, 0.2]),
+        (r#""clamp""#, [0.2, 0.8]),
+        (r#""mirror""#, [0.2, 0.8]),
+        (r#""black""#, [0.0, 0.0]),
+        (r#"["clamp", "black"]"#, [0.0, 0.0]),
+        (r#"["clamp", "repeat"]"#, [0.2, 0.8]),
+    ] {
+        std::fs::write(dir.join("scene.toml"), scene(wrap)).unwrap();
+        let l = load_scene(&dir.join("scene.toml")).unwrap_or_else(|e| panic!("{e}"));
+        let Material::Phong(p) =
+            &l.scene.materials[l.scene.geometry.primitives[0].material as usize]
+        else {
+            panic!("expected a Phong material");
+        };
+        for (u, want) in [-0.25, 1.25].into_iter().zip(want) {
+            let at = TextureCoords {
+                uv: [u, 1.5],
+                object_point: Vec3::ZERO,
+            };
+            let got = p.diffuse.evaluate(&at).g;
+            assert!((got - want).abs() < 0.01, "{wrap} at u = {u}: {got}");
+        }
+    }
+    std::fs::write(dir.join("scene.toml"), scene(r#""tile""#)).unwrap();
+    let e = match load_scene(&dir.join("scene.toml")) {
+        Ok(_) => panic!("expected an error"),
+        Err(e) => e,
+    };
+    assert!(
+        e.message.contains("unknown wrap `tile`") && e.to_string().contains(":2:"),
+        "{e}"
+    );
+}

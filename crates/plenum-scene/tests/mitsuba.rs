@@ -571,3 +571,42 @@ fn normal_and_bump_maps_turn_the_shading_normal() {
         "{e}"
     );
 }
+
+/// A bitmap's `wrap_mode` continues it past its edges: repeated, mirrored or clamped.
+#[test]
+fn bitmap_wrap_modes() {
+    use plenum_core::material::Material;
+    use plenum_core::math::Vec3;
+    use plenum_core::texture::TextureCoords;
+    // Two texels, 0.2 and 0.8, read raw; u = −0.25 and 1.25 are the centres of the texels
+    // just outside.
+    let two = png(2, 1, 3, &[51, 51, 51, 204, 204, 204]);
+    for (mode, want) in [
+        ("repeat", [0.8, 0.2]),
+        ("mirror", [0.2, 0.8]),
+        ("clamp", [0.2, 0.8]),
+    ] {
+        let text = format!(
+            r#"<scene version="3.0.0"><emitter type="constant"/><sensor type="perspective"/>
+<shape type="sphere"><bsdf type="diffuse"><texture type="bitmap" name="reflectance">
+<string name="filename" value="two.png"/><boolean name="raw" value="true"/><string name="wrap_mode" value="{mode}"/>
+</texture></bsdf></shape></scene>"#
+        );
+        let l = load_files(&[("scene.xml", text.as_bytes()), ("two.png", &two[..])])
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        let Material::Diffuse(d) =
+            &l.scene.materials[l.scene.geometry.primitives[0].material as usize]
+        else {
+            panic!("expected a diffuse material");
+        };
+        for (u, want) in [-0.25, 1.25].into_iter().zip(want) {
+            let at = TextureCoords {
+                uv: [u, 0.5],
+                object_point: Vec3::ZERO,
+            };
+            let got = d.reflectance.rgb(&at).g;
+            assert!((got - want).abs() < 1e-6, "{mode} at u = {u}: {got}");
+        }
+    }
+}

@@ -829,3 +829,41 @@ Shape "sphere"
     let back = load_files(&[("scene.toml", written.as_bytes())]).unwrap_or_else(|e| panic!("{e}"));
     check(&back, "native");
 }
+
+#[test]
+fn image_wrap_modes_continue_past_the_edges() {
+    use plenum_core::material::Material;
+    use plenum_core::math::Vec3;
+    use plenum_core::texture::TextureCoords;
+    // Two texels, 0.2 and 0.8 (read linear); u = 1.25 is the centre of the texel after the
+    // last: the first again, the last, or black.
+    let two = png(2, 1, 3, &[51, 51, 51, 204, 204, 204]);
+    for (wrap, want) in [("repeat", 0.2), ("clamp", 0.8), ("black", 0.0)] {
+        let text = format!(
+            r#"WorldBegin
+LightSource "point" "rgb I" [ 1 1 1 ]
+Texture "t" "spectrum" "imagemap" "string filename" "two.png" "string encoding" "linear" "string wrap" "{wrap}"
+Material "diffuse" "texture reflectance" "t"
+Shape "sphere"
+"#
+        );
+        let l = load_files(&[("scene.pbrt", text.as_bytes()), ("two.png", &two[..])])
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        let Material::Diffuse(d) =
+            &l.scene.materials[l.scene.geometry.primitives[0].material as usize]
+        else {
+            panic!("expected a diffuse material");
+        };
+        let at = TextureCoords {
+            uv: [1.25, 0.5],
+            object_point: Vec3::ZERO,
+        };
+        let got = d.reflectance.rgb(&at).g;
+        assert!((got - want).abs() < 1e-6, "{wrap}: {got}");
+    }
+    let e = error(&format!(
+        "{VIEW}Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"x.png\" \"string wrap\" \"tile\"\n"
+    ));
+    assert!(e.message.contains("unknown wrap `tile`"), "{e}");
+}

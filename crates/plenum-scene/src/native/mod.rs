@@ -13,7 +13,7 @@ use plenum_core::geometry::TriangleMesh;
 use plenum_core::material::FloatTexture;
 use plenum_core::math::{Matrix4, Transform, Vec3};
 use plenum_core::scene::{MaterialId, SceneBuilder};
-use plenum_core::texture::{ImageTexture, Texture};
+use plenum_core::texture::{ImageTexture, Texture, Wrap};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -173,6 +173,34 @@ impl<'s> Reader<'s> {
         })
     }
 
+    /// An image's `wrap`: one mode for u and v, or `[u, v]`.
+    fn wrap(&self, v: &Value<'s>) -> Result<[Wrap; 2]> {
+        let one = |w: &Value<'s>| -> Result<Wrap> {
+            Ok(match self.src.string(w)? {
+                "repeat" => Wrap::Repeat,
+                "clamp" => Wrap::Clamp,
+                "mirror" => Wrap::Mirror,
+                "black" => Wrap::Black,
+                other => {
+                    return Err(self.src.error(
+                        w.span(),
+                        format!("unknown wrap `{other}`: expected repeat, clamp, mirror or black"),
+                    ))
+                }
+            })
+        };
+        match v.get_ref() {
+            DeValue::Array(_) => match self.src.array(v, "[u, v] wrap modes")? {
+                [u, w] => Ok([one(u)?, one(w)?]),
+                list => Err(self.src.error(
+                    v.span(),
+                    format!("expected two wrap modes [u, v], found {}", list.len()),
+                )),
+            },
+            _ => Ok([one(v)?; 2]),
+        }
+    }
+
     fn texture(&self, v: &Value<'s>) -> Result<Texture> {
         let DeValue::Table(_) = v.get_ref() else {
             return Ok(Texture::Constant(self.color(v)?));
@@ -183,7 +211,7 @@ impl<'s> Reader<'s> {
                 "a texture",
                 &[
                     "texture", "even", "odd", "scale", "file", "channel", "encoding", "corners",
-                    "textures", "amount",
+                    "textures", "amount", "wrap",
                 ],
             )?;
             let k = f.required("texture")?;
@@ -207,7 +235,7 @@ impl<'s> Reader<'s> {
                 let f = self.src.table(
                     v,
                     "an image texture",
-                    &["texture", "file", "scale", "channel", "encoding"],
+                    &["texture", "file", "scale", "channel", "encoding", "wrap"],
                 )?;
                 let file = f.required("file")?;
                 // "linear": 8-bit values as stored, for data (heights, normals).
@@ -270,7 +298,11 @@ impl<'s> Reader<'s> {
                 };
                 let image = ImageTexture::new(width, height, texels, scale)
                     .ok_or_else(|| self.src.error(file.span(), "the image is empty"))?;
-                Ok(Texture::Image(Arc::new(image)))
+                let wrap = match f.get("wrap") {
+                    None => [Wrap::Repeat; 2],
+                    Some(w) => self.wrap(w)?,
+                };
+                Ok(Texture::Image(Arc::new(image.with_wrap(wrap))))
             }
             "bilerp" => {
                 let f = self
