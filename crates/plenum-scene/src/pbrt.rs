@@ -1687,12 +1687,14 @@ impl Parser {
                         self.warn(&l, "wrap `octahedralsphere` is not supported: repeating");
                         Wrap::Repeat
                     }
-                    Some((w, l)) => return Err(self.error(
-                        &l,
-                        format!(
+                    Some((w, l)) => {
+                        return Err(self.error(
+                            &l,
+                            format!(
                             "unknown wrap `{w}`: expected repeat, black, clamp or octahedralsphere"
                         ),
-                    )),
+                        ))
+                    }
                 };
                 let read = if linear {
                     plenum_image::read_data_texture(&path)
