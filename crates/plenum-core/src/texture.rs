@@ -129,6 +129,26 @@ impl Texture {
         }
     }
 
+    /// The texture's mean over (u, v): exact for constants, checkers, images and bilerps,
+    /// the product or mix of the operands' means for `Scale` and `Mix` (an estimate, what
+    /// weighing lights by their power needs).
+    pub fn average(&self) -> Color {
+        match self {
+            Texture::Constant(c) => *c,
+            Texture::Checker2d { even, odd, .. } | Texture::Checker3d { even, odd, .. } => {
+                (*even + *odd) * 0.5
+            }
+            Texture::Image(image) => image.average(),
+            Texture::Bilerp(b) => b.0.iter().fold(Color::BLACK, |a, &c| a + c) * 0.25,
+            Texture::Scale(t) => t[0].average() * t[1].average(),
+            Texture::Mix(t) => {
+                let m = t[2].average();
+                let w = (m.r + m.g + m.b) / 3.0;
+                t[0].average() * (1.0 - w) + t[1].average() * w
+            }
+        }
+    }
+
     /// True when the texture is black everywhere: lets the integrator skip work.
     pub fn is_black(&self) -> bool {
         match self {

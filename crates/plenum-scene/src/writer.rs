@@ -323,6 +323,7 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                     radiance,
                     samples,
                     two_sided,
+                    texture: emitted,
                     ..
                 },
             )) if written_with_object(scene, index) => {
@@ -336,7 +337,20 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                     w,
                     "[[objects]]\nname = {}{material}\n{}\ntwo_sided = {two_sided}\nlight_samples = {samples}",
                     quote(name),
-                    emission(scene, i, *radiance, "emission")
+                    match emitted {
+                        // A texture that is not white is scaled by the radiance.
+                        Some(t) => format!(
+                            "emission = {}",
+                            texture(&match *radiance == Color::WHITE {
+                                true => t.texture.clone(),
+                                false => Texture::Scale(std::sync::Arc::new([
+                                    Texture::Constant(*radiance),
+                                    t.texture.clone(),
+                                ])),
+                            })
+                        ),
+                        None => emission(scene, i, *radiance, "emission"),
+                    }
                 )
             }
             Some(_) => continue,

@@ -130,6 +130,21 @@ impl Shape {
         }
     }
 
+    /// The texture coordinates at `p` (on the surface, in the shape's coordinates) of part
+    /// `part`: what a hit there would report. For points no ray found, such as an area
+    /// light's samples.
+    pub fn uv_at(&self, p: Vec3, part: u32) -> [f64; 2] {
+        let hit = |u, v| HitRecord { t: 0.0, u, v, part };
+        let at = Ray::new(p, Vec3::Z);
+        match self {
+            Shape::Mesh(m) => {
+                let [b1, b2] = m.barycentrics(part, p);
+                m.surface(&at, &hit(b1, b2)).uv
+            }
+            _ => self.surface(&at, &hit(0.0, 0.0), true).uv,
+        }
+    }
+
     /// ∂p/∂u and ∂p/∂v at a hit whose geometry is `g` (computed with texture coordinates),
     /// in the shape's coordinates: the tangent frame of normal and bump maps. Where the
     /// parametrisation is singular (a sphere's pole, a disk's centre, a triangle with

@@ -111,8 +111,9 @@ struct Vertex {
     /// Area densities of reaching this vertex forward along its subpath and in reverse.
     pdf_fwd: f64,
     pdf_rev: f64,
-    /// Emission of a camera path's surface that no light stands for (a Phong k_e).
-    ke: SampledSpectrum,
+    /// What a camera path's surface emits: the radiance of the area light it is on
+    /// (`light`), or a Phong k_e no light stands for.
+    le: SampledSpectrum,
     time: f64,
     /// The primitive a surface vertex lies on, for the ray tree.
     primitive: Option<u32>,
@@ -135,7 +136,7 @@ impl Vertex {
             delta: false,
             pdf_fwd: 0.0,
             pdf_rev: 0.0,
-            ke: SampledSpectrum::ZERO,
+            le: SampledSpectrum::ZERO,
             time: 0.0,
             primitive: None,
         }
@@ -300,8 +301,12 @@ impl<'a> BidirectionalPathTracer<'a> {
         let mut l = SampledSpectrum::ZERO;
         // Emission no light stands for, Phong k_e, by s = 0 alone (the background is a
         // light at infinity, found by every strategy).
-        for v in camera_path.iter().skip(1).filter(|v| !v.infinite) {
-            l += v.beta * v.ke;
+        for v in camera_path
+            .iter()
+            .skip(1)
+            .filter(|v| !v.infinite && v.light.is_none())
+        {
+            l += v.beta * v.le;
         }
         let max_vertices = self.max_depth as usize + 3;
         for t in 1..=camera_path.len() {
@@ -517,14 +522,17 @@ impl<'a> BidirectionalPathTracer<'a> {
                 delta: false,
                 pdf_fwd: 0.0,
                 pdf_rev: 0.0,
-                ke: SampledSpectrum::ZERO,
+                le: SampledSpectrum::ZERO,
                 time: ray.time,
                 primitive: Some(prim),
             };
-            if mode == TransportMode::Radiance && v.light.is_none() {
-                if let Some(ke) = scene.phong_emission(&it, wl) {
-                    v.ke = ke;
-                }
+            if mode == TransportMode::Radiance {
+                v.le = match v.light {
+                    Some(light) => scene.lights.emitted(light, &it.texture, wl),
+                    None => scene
+                        .phong_emission(&it, wl)
+                        .unwrap_or(SampledSpectrum::ZERO),
+                };
             }
             v.pdf_fwd = prev.convert_density(pdf_fwd, &v);
             path.push(v);
@@ -773,7 +781,7 @@ impl<'a> BidirectionalPathTracer<'a> {
         };
         let w = v.toward(toward);
         if scene.lights[i as usize].emits_toward(v.n, w) {
-            scene.lights.spectrum(i, wl)
+            v.le
         } else {
             SampledSpectrum::ZERO
         }

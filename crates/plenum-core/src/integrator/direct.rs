@@ -99,7 +99,8 @@ pub(super) fn emitted_mis(
         return SampledSpectrum::ZERO;
     }
     let pdf_light = scene.lights.sampler.pmf(light) * l.pdf_li(from, it.p, it.n);
-    scene.lights.spectrum(light, wl) * power_heuristic(bsdf_samples * pdf_bsdf, pdf_light)
+    scene.lights.emitted(light, &it.texture, wl)
+        * power_heuristic(bsdf_samples * pdf_bsdf, pdf_light)
 }
 
 /// A BSDF-sampled ray's part of the light from infinity along `d`: the infinite lights,

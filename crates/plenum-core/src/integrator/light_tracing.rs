@@ -26,6 +26,7 @@ use crate::camera::Camera;
 use crate::color::Color;
 use crate::film::SplatBuffer;
 use crate::light::{EmissionSample, Light, AREA_SHADOW_END};
+use crate::material::rgb_radiance;
 use crate::math::{offset_ray_origin, Ray, Vec3};
 use crate::sampling::SampleStream;
 use crate::scene::Scene;
@@ -199,7 +200,10 @@ impl<'a> LightTracer<'a> {
         {
             return None;
         }
-        let l = self.scene.lights.spectrum(index, wl);
+        let l = match es.radiance {
+            Some(c) => rgb_radiance(c, wl),
+            None => self.scene.lights.spectrum(index, wl),
+        };
         Some((c.raster, l * (geometric * c.we / (c.pdf * pmf)), c.wi))
     }
 

@@ -160,7 +160,9 @@ impl<'a> Whitted<'a> {
             Some(l) => {
                 let light = &self.scene.lights[l as usize];
                 if light.emits_toward(it.n, v) {
-                    color += light.rgb();
+                    color += light
+                        .textured_radiance_at(&it.texture)
+                        .unwrap_or(light.rgb());
                 }
             }
             None => color += k.emissive,

@@ -25,8 +25,8 @@ pub struct EmissionSample {
     pub n: Option<Vec3>,
     /// What multiplies the light's spectrum: a spot's falloff, 1 otherwise.
     pub scale: f64,
-    /// Radiance that depends on the direction (an environment map's, linear RGB), in place
-    /// of the light's spectrum times `scale`.
+    /// Radiance that varies (an environment map's by direction, a textured area light's over
+    /// its surface), linear RGB, in place of the light's spectrum times `scale`.
     pub radiance: Option<Color>,
     pub pdf: EmissionPdf,
 }
@@ -73,7 +73,7 @@ impl Light {
                 two_sided,
                 ..
             } => {
-                let (q, n) = shape.sample_area(u_pos)?;
+                let (q, n, at) = shape.sample_point(u_pos)?;
                 // A two-sided surface: u_dir[0] picks the side and is stretched back to [0, 1).
                 let (side, u, half) = if two_sided {
                     if u_dir[0] < 0.5 {
@@ -91,8 +91,9 @@ impl Light {
                 let local = cosine_hemisphere(u);
                 let d = Frame::from_z(side).to_world(local);
                 let pdf_dir = half * local.z / PI;
+                let radiance = self.textured_radiance(at);
                 (pdf_dir > 0.0)
-                    .then(|| sample(q, d, Some(n), 1.0, None, 1.0 / shape.area(), pdf_dir))
+                    .then(|| sample(q, d, Some(n), 1.0, radiance, 1.0 / shape.area(), pdf_dir))
             }
             Light::Point { position, .. } => Some(sample(
                 position,
@@ -226,6 +227,7 @@ mod tests {
             radiance: Color::gray(1.0),
             samples: 1,
             two_sided,
+            texture: None,
         }
     }
 

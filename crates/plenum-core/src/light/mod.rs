@@ -18,7 +18,10 @@ use crate::sampling::{
 use std::sync::Arc;
 
 mod emission;
+mod textured;
 pub use emission::{EmissionPdf, EmissionSample};
+pub use textured::EmissionTexture;
+use textured::EmitterPoint;
 
 /// Distance attenuation f(d) = min(1, 1 / (a + b·d + c·d²)).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -78,6 +81,9 @@ pub enum Light {
         /// Shadow rays per shading point, stratified over the area (rounded up to a square).
         samples: u32,
         two_sided: bool,
+        /// A texture that multiplies `radiance` over the surface (then RGB: a spectrum the
+        /// light was given is not used).
+        texture: Option<Arc<EmissionTexture>>,
     },
     /// Radiance `radiance` arriving from every direction at infinity (physically based
     /// integrators only; Whitted's scenes have their `background`).
@@ -143,32 +149,9 @@ impl Emitter {
     /// [`Polygon::triangles`](crate::geometry::Polygon::triangles)); `None` for shapes it cannot
     /// sample (planes, cylinders, cones) or without area.
     pub fn of_shape(shape: &Shape, to_world: &Transform) -> Option<Emitter> {
-        let world = |p: Vec3| to_world.point(p);
-        // A transform that mirrors (negative determinant) reverses the winding of what it
-        // places, but not the normal a hit reports (the inverse transpose): wound back, the
-        // triangles' normals are the hit's, so one-sided light leaves the same side for
-        // light sampling, light paths and rays that meet it.
-        let mirrors = {
-            let [x, y, z] = [Vec3::X, Vec3::Y, Vec3::Z].map(|a| to_world.vector(a));
-            x.dot(y.cross(z)) < 0.0
-        };
-        let place = |[p, q, r]: [Vec3; 3]| {
-            if mirrors {
-                [world(p), world(r), world(q)]
-            } else {
-                [world(p), world(q), world(r)]
-            }
-        };
-        let on_world = |ts: Vec<[Vec3; 3]>| ts.into_iter().map(place).collect();
-        // The box's faces are convex: a fan covers each.
-        let fan = |vs: &[Vec3]| -> Vec<[Vec3; 3]> {
-            (1..vs.len().saturating_sub(1))
-                .map(|i| place([vs[0], vs[i], vs[i + 1]]))
-                .collect()
-        };
         match shape {
             Shape::Sphere(s) => {
-                let center = world(s.center);
+                let center = to_world.point(s.center);
                 let axes = [Vec3::X, Vec3::Y, Vec3::Z].map(|a| to_world.vector(a).length());
                 let round = axes.iter().all(|&l| (l - axes[0]).abs() <= 1e-9 * axes[0]);
                 round.then(|| Emitter::Sphere {
@@ -181,12 +164,50 @@ impl Emitter {
                 normal: d.normal.normalized(),
                 radius: d.radius,
             }),
-            Shape::Mesh(m) => Emitter::triangles(m.outward_triangles().map(place).collect()),
+            _ => Emitter::triangles(
+                Emitter::object_triangles(shape, to_world)?
+                    .into_iter()
+                    .map(|(_, t)| t.map(|p| to_world.point(p)))
+                    .collect(),
+            ),
+        }
+    }
+
+    /// The triangles of [`Emitter::of_shape`] in the shape's own coordinates, in order, each
+    /// with the part of the shape it lies on; `None` for shapes drawn otherwise.
+    pub(crate) fn object_triangles(
+        shape: &Shape,
+        to_world: &Transform,
+    ) -> Option<Vec<(u32, [Vec3; 3])>> {
+        // A transform that mirrors (negative determinant) reverses the winding of what it
+        // places, but not the normal a hit reports (the inverse transpose): wound back, the
+        // triangles' normals are the hit's, so one-sided light leaves the same side for
+        // light sampling, light paths and rays that meet it.
+        let mirrors = {
+            let [x, y, z] = [Vec3::X, Vec3::Y, Vec3::Z].map(|a| to_world.vector(a));
+            x.dot(y.cross(z)) < 0.0
+        };
+        let wind = |(part, [p, q, r]): (u32, [Vec3; 3])| {
+            if mirrors {
+                (part, [p, r, q])
+            } else {
+                (part, [p, q, r])
+            }
+        };
+        let on_part = |part: u32, ts: Vec<[Vec3; 3]>| ts.into_iter().map(move |t| wind((part, t)));
+        // The box's faces are convex: a fan covers each.
+        let fan = |part: u32, vs: &[Vec3]| -> Vec<(u32, [Vec3; 3])> {
+            (1..vs.len().saturating_sub(1))
+                .map(|i| wind((part, [vs[0], vs[i], vs[i + 1]])))
+                .collect()
+        };
+        Some(match shape {
+            Shape::Mesh(m) => m.outward_triangles().map(wind).collect(),
             // Concave faces too: the polygon's own triangles, not a fan.
-            Shape::Polygon(p) => Emitter::triangles(on_world(p.triangles())),
-            Shape::Polyhedron(p) => Emitter::triangles(on_world(
-                p.faces().iter().flat_map(|f| f.triangles()).collect(),
-            )),
+            Shape::Polygon(p) => on_part(0, p.triangles()).collect(),
+            Shape::Polyhedron(p) => (p.faces().iter().enumerate())
+                .flat_map(|(i, f)| on_part(i as u32, f.triangles()))
+                .collect(),
             Shape::Cuboid(c) => {
                 let (a, b) = (c.min, c.max);
                 let v = |x: bool, y: bool, z: bool| {
@@ -196,49 +217,68 @@ impl Emitter {
                         if z { b.z } else { a.z },
                     )
                 };
-                // Six faces, each wound so that its normal points out of the box.
+                // Six faces, each wound so that its normal points out of the box, with the
+                // part a hit on it reports (2·axis, +1 on the far side).
                 let faces = [
-                    [
-                        v(false, false, false),
-                        v(false, true, false),
-                        v(true, true, false),
-                        v(true, false, false),
-                    ],
-                    [
-                        v(false, false, true),
-                        v(true, false, true),
-                        v(true, true, true),
-                        v(false, true, true),
-                    ],
-                    [
-                        v(false, false, false),
-                        v(true, false, false),
-                        v(true, false, true),
-                        v(false, false, true),
-                    ],
-                    [
-                        v(false, true, false),
-                        v(false, true, true),
-                        v(true, true, true),
-                        v(true, true, false),
-                    ],
-                    [
-                        v(false, false, false),
-                        v(false, false, true),
-                        v(false, true, true),
-                        v(false, true, false),
-                    ],
-                    [
-                        v(true, false, false),
-                        v(true, true, false),
-                        v(true, true, true),
-                        v(true, false, true),
-                    ],
+                    (
+                        4,
+                        [
+                            v(false, false, false),
+                            v(false, true, false),
+                            v(true, true, false),
+                            v(true, false, false),
+                        ],
+                    ),
+                    (
+                        5,
+                        [
+                            v(false, false, true),
+                            v(true, false, true),
+                            v(true, true, true),
+                            v(false, true, true),
+                        ],
+                    ),
+                    (
+                        2,
+                        [
+                            v(false, false, false),
+                            v(true, false, false),
+                            v(true, false, true),
+                            v(false, false, true),
+                        ],
+                    ),
+                    (
+                        3,
+                        [
+                            v(false, true, false),
+                            v(false, true, true),
+                            v(true, true, true),
+                            v(true, true, false),
+                        ],
+                    ),
+                    (
+                        0,
+                        [
+                            v(false, false, false),
+                            v(false, false, true),
+                            v(false, true, true),
+                            v(false, true, false),
+                        ],
+                    ),
+                    (
+                        1,
+                        [
+                            v(true, false, false),
+                            v(true, true, false),
+                            v(true, true, true),
+                            v(true, false, true),
+                        ],
+                    ),
                 ];
-                Emitter::triangles(faces.iter().flat_map(|f| fan(f)).collect())
+                faces.iter().flat_map(|(part, f)| fan(*part, f)).collect()
             }
-            _ => None,
-        }
+            _ => return None,
+        })
     }
 
     /// An emitter made of world-space triangles; `None` when they have no area.
@@ -297,19 +337,25 @@ impl Emitter {
     /// A point uniform over the surface by area (density 1 / [`Emitter::area`]) and its unit
     /// normal: where light paths start.
     pub fn sample_area(&self, u: [f64; 2]) -> Option<(Vec3, Vec3)> {
+        self.sample_point(u).map(|(p, n, _)| (p, n))
+    }
+
+    /// [`Emitter::sample_area`], with where on the emitter the point lies.
+    fn sample_point(&self, u: [f64; 2]) -> Option<(Vec3, Vec3, EmitterPoint)> {
+        let world = |(p, n): (Vec3, Vec3)| (p, n, EmitterPoint::World(p));
         Some(match self {
             Emitter::Sphere { center, radius } => {
                 let n = uniform_sphere(u);
-                (*center + n * *radius, n)
+                world((*center + n * *radius, n))
             }
             Emitter::Rectangle {
                 corner,
                 edge_u,
                 edge_v,
-            } => (
+            } => world((
                 *corner + *edge_u * u[0] + *edge_v * u[1],
                 edge_u.cross(*edge_v).normalized(),
-            ),
+            )),
             Emitter::Disk {
                 center,
                 normal,
@@ -317,7 +363,7 @@ impl Emitter {
             } => {
                 let (x, y) = concentric_disk(u);
                 let (s, t) = normal.orthonormal_basis();
-                (*center + (s * x + t * y) * *radius, *normal)
+                world((*center + (s * x + t * y) * *radius, *normal))
             }
             Emitter::Triangles {
                 triangles,
@@ -335,15 +381,22 @@ impl Emitter {
                 let u0 = ((target - below) / width).clamp(0.0, 1.0 - f64::EPSILON);
                 let [a, b, c] = triangles[i];
                 let (b0, b1) = uniform_triangle([u0, u[1]]);
-                (a * b0 + b * b1 + c * (1.0 - b0 - b1), normals[i])
+                (
+                    a * b0 + b * b1 + c * (1.0 - b0 - b1),
+                    normals[i],
+                    EmitterPoint::Triangle {
+                        triangle: i,
+                        b: [b0, b1],
+                    },
+                )
             }
         })
     }
 
     /// A point of the surface for `p` to aim at, its unit normal, and the pdf of choosing it
     /// with respect to solid angle at `p` (the area pdf converted by d² / |cos θ_light|);
-    /// `None` if the sample sees the surface edge-on.
-    fn sample_with_normal(&self, p: Vec3, u: [f64; 2]) -> Option<(Vec3, Vec3, f64)> {
+    /// `None` if the sample sees the surface edge-on. Also where on the emitter the point lies.
+    fn sample_with_normal(&self, p: Vec3, u: [f64; 2]) -> Option<(Vec3, Vec3, f64, EmitterPoint)> {
         if let Emitter::Sphere { center, radius } = self {
             let to_center = *center - p;
             let d2 = to_center.length_squared();
@@ -361,21 +414,17 @@ impl Emitter {
                 let s = b - disc.sqrt();
                 let q = p + w * s;
                 let n = (q - *center) / *radius;
-                return Some((q, n, uniform_cone_pdf(cos_max)));
+                return Some((q, n, uniform_cone_pdf(cos_max), EmitterPoint::World(q)));
             }
         }
-        let (point, normal) = self.sample_area(u)?;
+        let (point, normal, at) = self.sample_point(u)?;
         let to = point - p;
         let d2 = to.length_squared();
         let cos_light = normal.dot(to).abs() / d2.sqrt();
         if cos_light <= 0.0 || d2 == 0.0 {
             return None;
         }
-        Some((point, normal, d2 / (cos_light * self.area())))
-    }
-
-    fn sample(&self, p: Vec3, u: [f64; 2]) -> Option<(Vec3, f64)> {
-        self.sample_with_normal(p, u).map(|(q, _, pdf)| (q, pdf))
+        Some((point, normal, d2 / (cos_light * self.area()), at))
     }
 }
 
@@ -398,8 +447,8 @@ pub struct LightSample {
     pub pdf: f64,
     /// The light is a point or a direction: no other strategy can find it.
     pub delta: bool,
-    /// Radiance that depends on the direction (an environment map's, linear RGB), in place
-    /// of the light's spectrum times `scale`.
+    /// Radiance that varies (an environment map's by direction, a textured area light's over
+    /// its surface), linear RGB, in place of the light's spectrum times `scale`.
     pub radiance: Option<Color>,
     /// Where the shadow ray stops, as a fraction of the way to `position`.
     pub shadow_end: f64,
@@ -456,23 +505,27 @@ impl Light {
                 two_sided,
                 ..
             } => {
-                let (q, n, pdf) = shape.sample_with_normal(p, u)?;
+                let (q, n, pdf, at) = shape.sample_with_normal(p, u)?;
                 let to = q - p;
                 let d = to.length();
                 if !(pdf > 0.0 && pdf.is_finite() && d > 0.0) {
                     return None;
                 }
                 let wi = to / d;
-                let lit = two_sided || n.dot(-wi) > 0.0;
+                let scale = if two_sided || n.dot(-wi) > 0.0 {
+                    1.0
+                } else {
+                    0.0
+                };
                 Some(LightSample {
                     wi,
                     distance: d,
                     position: Some(q),
                     normal: Some(n),
-                    scale: if lit { 1.0 } else { 0.0 },
+                    scale,
                     pdf,
                     delta: false,
-                    radiance: None,
+                    radiance: self.textured_radiance(at).map(|c| c * scale),
                     shadow_end: AREA_SHADOW_END,
                 })
             }
@@ -590,14 +643,45 @@ impl Light {
                 shape,
                 radiance,
                 two_sided,
+                texture,
                 ..
             } => {
                 let sides = if *two_sided { 2.0 } else { 1.0 };
-                PI * sides * shape.area() * radiance.luminance()
+                let mean = match texture {
+                    Some(t) => *radiance * t.texture.average(),
+                    None => *radiance,
+                };
+                PI * sides * shape.area() * mean.luminance()
             }
             Light::Directional { intensity, .. } => PI * radius * radius * intensity.luminance(),
             Light::Infinite { radiance } => 4.0 * PI * PI * radius * radius * radiance.luminance(),
             Light::Environment { map, .. } => map.map.power_estimate(radius),
+        }
+    }
+
+    /// A textured area light's radiance at a point of its surface (linear RGB); `None` where
+    /// the light's spectrum is its radiance everywhere.
+    fn textured_radiance(&self, at: EmitterPoint) -> Option<Color> {
+        match self {
+            Light::Area {
+                radiance,
+                texture: Some(t),
+                ..
+            } => Some(*radiance * t.at(at)),
+            _ => None,
+        }
+    }
+
+    /// A textured area light's radiance where a ray met its surface (linear RGB); `None`
+    /// where the light's spectrum is its radiance everywhere.
+    pub fn textured_radiance_at(&self, at: &crate::texture::TextureCoords) -> Option<Color> {
+        match self {
+            Light::Area {
+                radiance,
+                texture: Some(t),
+                ..
+            } => Some(*radiance * t.texture.evaluate(at)),
+            _ => None,
         }
     }
 
@@ -636,9 +720,10 @@ impl Light {
                 radiance,
                 ..
             } => {
-                let (point, pdf) = shape.sample(p, u)?;
+                let (point, _, pdf, at) = shape.sample_with_normal(p, u)?;
                 let to = point - p;
                 let d = to.length();
+                let radiance = self.textured_radiance(at).unwrap_or(radiance);
                 (pdf > 0.0 && pdf.is_finite() && d > 0.0).then(|| Incident {
                     wi: to / d,
                     distance: d,
@@ -815,6 +900,7 @@ mod tests {
                 radiance: Color::WHITE,
                 samples: 1,
                 two_sided: true,
+                texture: None,
             };
             SphericalBins::about_z(0.3, [30, 60])
                 .test(
@@ -831,7 +917,7 @@ mod tests {
                         );
                         // What the path tracer's MIS asks of a point a BSDF ray found, and
                         // what light sampling hands it, agree.
-                        let (q, n, sampled) = emitter.sample_with_normal(Vec3::ZERO, u).unwrap();
+                        let (q, n, sampled, _) = emitter.sample_with_normal(Vec3::ZERO, u).unwrap();
                         let asked = emitter.pdf(Vec3::ZERO, q, n);
                         assert!(
                             (asked / sampled - 1.0).abs() < 1e-9,

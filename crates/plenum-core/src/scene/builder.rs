@@ -11,10 +11,11 @@ use crate::accel::AccelKind;
 use crate::camera::CameraSettings;
 use crate::color::Color;
 use crate::geometry::{Disk, Polygon, Shape, Sphere};
-use crate::light::{Emitter, Light};
+use crate::light::{EmissionTexture, Emitter, Light};
 use crate::light_sampler::LightSamplerKind;
 use crate::material::{Material, MaterialId, PhongMaterial};
 use crate::math::{Motion, Transform};
+use crate::texture::Texture;
 use plenum_spectrum::Spectrum;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -55,6 +56,34 @@ impl SceneBuilder {
         if let Some(Light::Area { two_sided, .. }) = self.lights.last_mut() {
             *two_sided = false;
         }
+    }
+
+    /// Makes the last light added, an area light shown on the last object added (by
+    /// [`SceneBuilder::add_emissive_object`] or [`SceneBuilder::add_area_light`]), emit its
+    /// radiance times `texture`, looked up at its surface's (u, v). `false` where the last
+    /// light is not on the last object.
+    pub fn set_last_light_texture(&mut self, texture: Texture) -> bool {
+        let (
+            Some(p),
+            Some(Light::Area {
+                shape,
+                texture: slot,
+                ..
+            }),
+        ) = (self.primitives.last(), self.lights.last_mut())
+        else {
+            return false;
+        };
+        if p.light.map(|l| l as usize + 1) != Some(self.light_names.len()) {
+            return false;
+        }
+        let to_world = p
+            .to_world
+            .as_deref()
+            .copied()
+            .unwrap_or(Transform::IDENTITY);
+        *slot = EmissionTexture::new(texture, shape, &p.shape, &to_world).map(Arc::new);
+        slot.is_some()
     }
 
     /// Turns the shading normal of every object of material `id` placed from now on by a
@@ -102,6 +131,7 @@ impl SceneBuilder {
                 radiance,
                 samples,
                 two_sided,
+                texture: None,
             },
         );
         self.show_last_light_on_last_object();
@@ -245,6 +275,7 @@ impl SceneBuilder {
                 radiance,
                 samples,
                 two_sided: true,
+                texture: None,
             },
         );
         if shape.is_some() {
@@ -290,10 +321,22 @@ impl SceneBuilder {
             .iter()
             .map(|p| any(p, Material::is_transmissive))
             .collect();
+        // A textured light's surface is looked up where rays meet it.
+        let textured = |p: &Primitive| {
+            p.light.is_some_and(|l| {
+                matches!(
+                    self.lights[l as usize],
+                    Light::Area {
+                        texture: Some(_),
+                        ..
+                    }
+                )
+            })
+        };
         let needs_uv = self
             .primitives
             .iter()
-            .map(|p| any(p, Material::needs_uv))
+            .map(|p| any(p, Material::needs_uv) || textured(p))
             .collect();
         let lights = Lights::new(
             self.lights,

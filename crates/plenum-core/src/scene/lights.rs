@@ -7,6 +7,7 @@ use crate::light::Light;
 use crate::light_sampler::{LightSampler, LightSamplerKind};
 use crate::material::{rgb_radiance, scaled, SpectrumKind, SpectrumValue};
 use crate::math::Vec3;
+use crate::texture::TextureCoords;
 use plenum_spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
 #[derive(Clone, Debug, Default)]
@@ -96,6 +97,21 @@ impl Lights {
     #[inline]
     pub fn spectrum(&self, light: u32, wl: &SampledWavelengths) -> SampledSpectrum {
         self.spectra[light as usize].sample(wl)
+    }
+
+    /// What area light `light` sends from the point of its surface a ray met, whose texture
+    /// coordinates are `at`.
+    #[inline]
+    pub fn emitted(
+        &self,
+        light: u32,
+        at: &TextureCoords,
+        wl: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        match self.all[light as usize].textured_radiance_at(at) {
+            Some(c) => rgb_radiance(c, wl),
+            None => self.spectrum(light, wl),
+        }
     }
 
     /// What light `light`, one at infinity, sends along -`d` toward the scene.

@@ -5,6 +5,7 @@ use super::Reader;
 use crate::diagnostics::did_you_mean;
 use crate::reader::{Fields, Result, Value};
 use crate::{obj, ply};
+use plenum_core::color::Color;
 use plenum_core::geometry::{
     Cone, Cuboid, Cylinder, Disk, Partial, Plane, Polygon, Polyhedron, Shape, Sphere, TriangleMesh,
 };
@@ -12,6 +13,7 @@ use plenum_core::material::PhongMaterial;
 use plenum_core::math::{Transform, Vec3};
 use plenum_core::scene::{Alpha, MaterialId};
 use std::sync::Arc;
+use toml::de::DeValue;
 
 impl<'s> Reader<'s> {
     pub(super) fn object(&mut self, index: usize, v: &Value<'s>) -> Result<()> {
@@ -114,7 +116,15 @@ impl<'s> Reader<'s> {
                 ));
             }
             let scale = f.non_negative_or("emission_scale", 1.0)?;
-            let (radiance, spectrum) = self.emission(e, scale)?;
+            // A texture (a table naming one) varies the radiance over the surface.
+            let texture = match e.get_ref() {
+                DeValue::Table(t) if t.contains_key("texture") => Some(self.texture(e)?),
+                _ => None,
+            };
+            let (radiance, spectrum) = match texture {
+                Some(_) => (Color::gray(scale), None),
+                None => self.emission(e, scale)?,
+            };
             let samples = self.light_samples(&f, "light_samples")?;
             let two_sided = f.bool_or("two_sided", true)?;
             // Without a material of its own the object only shows its light.
@@ -135,6 +145,14 @@ impl<'s> Reader<'s> {
             }
             if let Some(s) = spectrum {
                 self.builder.set_last_light_spectrum(s, scale);
+            }
+            if let Some(t) = texture.filter(|_| added) {
+                if !self.builder.set_last_light_texture(t) {
+                    return Err(self.src.error(
+                        what,
+                        format!("a {kind} placed this way cannot have textured emission"),
+                    ));
+                }
             }
             return Ok(());
         }

@@ -412,10 +412,11 @@ impl TriangleMesh {
             .map(|(part, _)| (part, self.triangle(part)))
     }
 
-    /// Each triangle once, wound so that its corners' cross product points the way a hit
-    /// on it reports its normal: by the winding, or where the mesh has vertex normals, to
-    /// their side (as [`TriangleMesh::surface`] turns it). What an emitter samples.
-    pub fn outward_triangles(&self) -> impl Iterator<Item = [Vec3; 3]> + '_ {
+    /// Each triangle once with its part, wound so that its corners' cross product points the
+    /// way a hit on it reports its normal: by the winding, or where the mesh has vertex
+    /// normals, to their side (as [`TriangleMesh::surface`] turns it). What an emitter
+    /// samples.
+    pub fn outward_triangles(&self) -> impl Iterator<Item = (u32, [Vec3; 3])> + '_ {
         self.triangles().map(|(part, [p0, p1, p2])| {
             let normals = self
                 .vertex_indices(part)
@@ -425,9 +426,9 @@ impl TriangleMesh {
                     .fold(Vec3::ZERO, |a, &i| a + self.normals[i as usize])
             });
             if (p1 - p0).cross(p2 - p0).dot(shading) < 0.0 {
-                [p0, p2, p1]
+                (part, [p0, p2, p1])
             } else {
-                [p0, p1, p2]
+                (part, [p0, p1, p2])
             }
         })
     }
@@ -472,6 +473,20 @@ impl TriangleMesh {
     /// The corners of stored triangle `part`.
     pub fn triangle(&self, part: u32) -> [Vec3; 3] {
         self.corners_f32(part).map(widened)
+    }
+
+    /// The barycentric coordinates [b1, b2] (the weights of the second and third corners)
+    /// of `p` projected onto the plane of stored triangle `part`.
+    pub fn barycentrics(&self, part: u32, p: Vec3) -> [f64; 2] {
+        let [p0, p1, p2] = self.triangle(part);
+        let (e1, e2, d) = (p1 - p0, p2 - p0, p - p0);
+        let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+        let (d1, d2) = (d.dot(e1), d.dot(e2));
+        let det = d11 * d22 - d12 * d12;
+        if det == 0.0 {
+            return [0.0, 0.0];
+        }
+        [(d22 * d1 - d12 * d2) / det, (d11 * d2 - d12 * d1) / det]
     }
 
     fn corners_f32(&self, part: u32) -> Corners {

@@ -1,0 +1,112 @@
+//! Area lights whose radiance varies over their surface: a texture, looked up at the
+//! surface's (u, v) as a hit there reports it, multiplies the light's RGB radiance (pbrt-v4's
+//! image area lights, glTF's emissive textures, Mitsuba's textured `area` emitters).
+//!
+//! Rays that meet the light read the texture at their hit. Points sampled on the light
+//! (next-event estimation, light paths) find their (u, v) here: on triangles by
+//! interpolating each corner's, which the shape's own map gives, and on spheres and disks
+//! from the shape's map at the point taken back to the shape's coordinates.
+
+use super::Emitter;
+use crate::color::Color;
+use crate::geometry::Shape;
+use crate::math::{Transform, Vec3};
+use crate::texture::{Texture, TextureCoords};
+
+/// The texture of a textured area light, and where on its emitter (u, v) lies.
+#[derive(Clone, Debug)]
+pub struct EmissionTexture {
+    pub texture: Texture,
+    coords: EmitterCoords,
+}
+
+#[derive(Clone, Debug)]
+enum EmitterCoords {
+    /// Per triangle of [`Emitter::Triangles`], in its order: the corners in the shape's
+    /// coordinates and their (u, v).
+    Corners(Vec<[(Vec3, [f64; 2]); 3]>),
+    /// The shape (a sphere or disk) in its own coordinates, and the world-to-object map.
+    Shape { shape: Shape, to_object: Transform },
+}
+
+/// A point of an emitter: where a sample landed.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum EmitterPoint {
+    /// On triangle `triangle`, with weights `b` of its first two corners (the third's is
+    /// 1 − b₀ − b₁).
+    Triangle { triangle: usize, b: [f64; 2] },
+    /// At a world point of a sphere or disk.
+    World(Vec3),
+}
+
+impl EmissionTexture {
+    /// `texture` over the light `emitter` made of `shape` placed by `to_world`
+    /// ([`Emitter::of_shape`]); `None` for an emitter that is not that shape's.
+    pub fn new(
+        texture: Texture,
+        emitter: &Emitter,
+        shape: &Shape,
+        to_world: &Transform,
+    ) -> Option<EmissionTexture> {
+        let coords = match emitter {
+            Emitter::Triangles { triangles, .. } => {
+                let parts = Emitter::object_triangles(shape, to_world)?;
+                if parts.len() != triangles.len() {
+                    return None;
+                }
+                EmitterCoords::Corners(
+                    parts
+                        .into_iter()
+                        .map(|(part, t)| t.map(|p| (p, shape.uv_at(p, part))))
+                        .collect(),
+                )
+            }
+            _ => EmitterCoords::Shape {
+                shape: shape.clone(),
+                to_object: to_world.inverted(),
+            },
+        };
+        Some(EmissionTexture { texture, coords })
+    }
+
+    /// Where the texture is looked up at a sampled point.
+    pub(crate) fn coords(&self, at: EmitterPoint) -> TextureCoords {
+        match (&self.coords, at) {
+            (EmitterCoords::Corners(corners), EmitterPoint::Triangle { triangle, b }) => {
+                let w = [b[0], b[1], 1.0 - b[0] - b[1]];
+                let [(p0, t0), (p1, t1), (p2, t2)] = corners[triangle];
+                TextureCoords {
+                    uv: [
+                        t0[0] * w[0] + t1[0] * w[1] + t2[0] * w[2],
+                        t0[1] * w[0] + t1[1] * w[1] + t2[1] * w[2],
+                    ],
+                    object_point: p0 * w[0] + p1 * w[1] + p2 * w[2],
+                }
+            }
+            (EmitterCoords::Shape { shape, to_object }, EmitterPoint::World(q)) => {
+                let p = to_object.point(q);
+                TextureCoords {
+                    uv: shape.uv_at(p, 0),
+                    object_point: p,
+                }
+            }
+            // Not a point of this emitter (cannot happen for a texture made for it).
+            (_, _) => TextureCoords {
+                uv: [0.0, 0.0],
+                object_point: Vec3::ZERO,
+            },
+        }
+    }
+
+    /// The texture's value at a sampled point.
+    pub(crate) fn at(&self, point: EmitterPoint) -> Color {
+        self.texture.evaluate(&self.coords(point))
+    }
+}
+
+/// Equal when it is the same texture (as environment maps are compared).
+impl PartialEq for EmissionTexture {
+    fn eq(&self, o: &Self) -> bool {
+        std::ptr::eq(self, o)
+    }
+}
