@@ -170,6 +170,8 @@ struct Decoded {
 struct Surface {
     material: MaterialId,
     emission: Color,
+    /// The emissive texture (sRGB-decoded) times `emission`, where there is one.
+    emission_texture: Option<Texture>,
     alpha: Option<Alpha>,
 }
 
@@ -680,12 +682,18 @@ impl<'a> Reader<'a> {
         }
         let strength = m.emissive_strength().map_or(1.0, |x| x as f64);
         let [er, eg, eb] = m.emissive_factor().map(|x| x as f64 * strength);
-        if m.emissive_texture().is_some() {
-            self.warn(format!(
-                "{at}: the emissiveTexture is not supported: using its factor"
-            ));
-        }
         let emission = Color::new(er, eg, eb);
+        // The radiance is the factor (times the strength) times the texture's colour.
+        let emission_texture = match m.emissive_texture() {
+            Some(info) if !emission.is_black() => {
+                let d = self.texels(&info, true, base, &format!("{at}.emissiveTexture"))?;
+                Some(self.image_texture(&d, |i| {
+                    let t = d.texels.rgb[i];
+                    Color::new(t[0] as f64, t[1] as f64, t[2] as f64) * emission
+                })?)
+            }
+            _ => None,
+        };
 
         let coat = Material::CoatedDiffuse(CoatedDiffuseMaterial {
             reflectance: base_color.clone(),
@@ -743,6 +751,7 @@ impl<'a> Reader<'a> {
         let done = Surface {
             material: id,
             emission,
+            emission_texture,
             alpha: cut_out,
         };
         self.materials.insert(m.index(), done.clone());
@@ -779,6 +788,7 @@ impl<'a> Reader<'a> {
                         let Surface {
                             material,
                             emission,
+                            emission_texture,
                             alpha,
                         } = self.material(&p.material(), base)?;
                         self.bounds = self
@@ -790,15 +800,22 @@ impl<'a> Reader<'a> {
                             name.clone()
                         };
                         if emission.r > 0.0 || emission.g > 0.0 || emission.b > 0.0 {
-                            self.builder.add_emissive_object(
+                            let added = self.builder.add_emissive_object(
                                 pname,
                                 Shape::Mesh(m),
                                 to_world,
                                 material,
-                                emission,
+                                // The texture carries the factor.
+                                match emission_texture {
+                                    Some(_) => Color::WHITE,
+                                    None => emission,
+                                },
                                 true,
                                 1,
                             );
+                            if let Some(t) = emission_texture.filter(|_| added) {
+                                self.builder.set_last_light_texture(t);
+                            }
                             self.lights += 1;
                             if alpha.is_some() {
                                 self.warn(format!("{at}: an emissive material's alphaMode is not supported: the light is whole"));

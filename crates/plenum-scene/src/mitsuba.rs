@@ -1165,7 +1165,21 @@ impl<'d> Builder<'d> {
                 ),
             ));
         }
-        let (radiance, spectrum) = self.emission(e, "radiance")?;
+        // A texture for radiance (a bitmap, a checkerboard) varies it over the surface.
+        let texture = match self.prop(e, "radiance") {
+            Some(p) if matches!(p.value, Value::Object(_) | Value::Ref(_)) => {
+                let t = self.doc.object_of(p)?.unwrap();
+                match self.obj(t).plugin.as_str() {
+                    "blackbody" => None,
+                    _ => Some(self.texture_of(p)?),
+                }
+            }
+            _ => None,
+        };
+        let (radiance, spectrum) = match texture {
+            Some(_) => (Color::WHITE, None),
+            None => self.emission(e, "radiance")?,
+        };
         let material = self.shape_material(o, true)?;
         if self.shape_cut_out(o)?.is_some() {
             let l = ep.loc.clone();
@@ -1188,6 +1202,8 @@ impl<'d> Builder<'d> {
             );
         } else if let Some(s) = spectrum {
             self.builder.set_last_light_spectrum(s, 1.0);
+        } else if let Some(t) = texture {
+            self.builder.set_last_light_texture(t);
         }
         Ok(())
     }

@@ -13,14 +13,14 @@ use plenum_core::camera::{CameraSettings, Lens};
 use plenum_core::color::Color;
 use plenum_core::geometry::{Cylinder, Disk, Partial, Shape, Sphere, TriangleMesh};
 use plenum_core::integrator::IntegratorKind;
-use plenum_core::light::{Attenuation, Light};
+use plenum_core::light::{Attenuation, Light, Profile};
 use plenum_core::material::{
     CoatedDiffuseMaterial, ConductorMaterial, ConductorSpec, DielectricMaterial, DiffuseMaterial,
     DiffuseTransmissionMaterial, FloatTexture, Material, Roughness, SpectralTexture, SpectrumKind,
     SpectrumValue, ThinDielectricMaterial,
 };
 use plenum_core::math::{Matrix4, Transform, Vec3};
-use plenum_core::sampling::{FilterKind, SamplerKind};
+use plenum_core::sampling::{FilterKind, Frame, SamplerKind};
 use plenum_core::scene::{Alpha, Bitangent, Bump, MaterialId, SceneBuilder};
 use plenum_core::texture::{ImageTexture, Texture, Wrap};
 use plenum_spectrum::Spectrum;
@@ -164,6 +164,10 @@ struct AreaLight {
     radiance: Color,
     spectrum: Option<(Spectrum, f64)>,
     two_sided: bool,
+    /// An image over the surface's (u, v) (`filename`), in place of `L`.
+    image: Option<Texture>,
+    /// The power in watts the light is scaled to emit (`power`).
+    power: Option<f64>,
 }
 
 /// A shape recorded between `ObjectBegin` and `ObjectEnd`.
@@ -550,6 +554,17 @@ fn column_major(n: &[f64]) -> Matrix4 {
     m
 }
 
+/// The orthonormal frame whose axes are the light-space directions `axes` placed by `t`
+/// (pbrt-v4 composes a swap or a flip into some lights' transformations).
+fn light_frame(t: &Transform, axes: [Vec3; 3]) -> Frame {
+    let [x, y, z] = axes.map(|a| t.vector(a));
+    let z = z.normalized();
+    let x = (x - z * x.dot(z)).normalized();
+    // Keep y's side (the frame may be left-handed), square to the others.
+    let y = (y - z * y.dot(z) - x * y.dot(x)).normalized();
+    Frame { x, y, z }
+}
+
 fn finite(v: Vec3) -> bool {
     v.x.is_finite() && v.y.is_finite() && v.z.is_finite()
 }
@@ -706,6 +721,70 @@ impl Parser {
     /// Emitted light as pbrt-v4 normalises it: an rgb value as written (its spectrum is the
     /// colour space's illuminant, whose luminance pbrt divides out); a spectrum or
     /// blackbody scaled to luminance 1. Then times `scale`.
+    /// Gives the area light just placed its image and spectrum, and scales it to its power:
+    /// pbrt-v4 divides the power by π, the light's area, its sides and the mean luminance
+    /// of its image (not of `L`, whose luminance then still multiplies the power).
+    fn finish_area_light(&mut self, a: AreaLight, loc: &Loc) {
+        let mut k = 1.0;
+        if let (Some(watts), Some(Light::Area { shape, .. })) = (a.power, self.builder.last_light())
+        {
+            let luminance = a.image.as_ref().map_or(1.0, |t| t.average().luminance());
+            let sides = if a.two_sided { 2.0 } else { 1.0 };
+            let emitted = std::f64::consts::PI * sides * shape.area() * luminance;
+            if emitted > 0.0 {
+                k = watts / emitted;
+            }
+        }
+        match (a.image, a.spectrum) {
+            (Some(image), _) => {
+                self.builder.scale_last_light(k);
+                if !self.builder.set_last_light_texture(image) {
+                    self.warn(
+                        loc,
+                        "an image on this shape's light is not supported: white",
+                    );
+                }
+            }
+            (None, Some((s, scale))) => self.builder.set_last_light_spectrum(s, scale * k),
+            (None, None) => self.builder.scale_last_light(k),
+        }
+    }
+
+    /// The image at `path` as a texture, each texel through `texel`; 8-bit images decoded
+    /// from sRGB unless `linear`. An unreadable image is warned about at `floc`, saying
+    /// what is used instead (`fallback`): `None`.
+    #[allow(clippy::too_many_arguments)]
+    fn image(
+        &mut self,
+        path: &Path,
+        floc: &Loc,
+        fallback: &str,
+        linear: bool,
+        texel: impl Fn(Color) -> Color,
+        scale_uv: [f64; 2],
+        wrap: Wrap,
+    ) -> Result<Option<Texture>> {
+        let read = if linear {
+            plenum_image::read_data_texture(path)
+        } else {
+            plenum_image::read_texture(path)
+        };
+        let texels = match read {
+            Ok(t) => t,
+            Err(e) => {
+                self.warn(floc, format!("{e}: {fallback}"));
+                return Ok(None);
+            }
+        };
+        let (width, height) = (texels.width, texels.height);
+        let rgb = texels.rgb.iter();
+        let texels = rgb.map(|t| texel(Color::new(t[0] as f64, t[1] as f64, t[2] as f64)));
+        match ImageTexture::new(width, height, texels.collect(), scale_uv) {
+            Some(i) => Ok(Some(Texture::Image(Arc::new(i.with_wrap([wrap; 2]))))),
+            None => Err(self.error(floc, "the image is empty")),
+        }
+    }
+
     fn emission(&self, p: &Params, name: &str) -> Result<(Color, Option<(Spectrum, f64)>)> {
         let scale = self.float(p, "scale", 1.0)?;
         let Some(q) = p.get(name) else {
@@ -1088,19 +1167,37 @@ impl Parser {
                 }
                 let (radiance, spectrum) = self.emission(&params, "L")?;
                 let two_sided = self.boolean_param(&params, "twosided", false)?;
-                for key in ["filename", "power", "alpha"] {
-                    if let Some(q) = params.get(key) {
-                        let l = q.loc.clone();
-                        self.warn(
-                            &l,
-                            format!("`{key}` of an area light is not supported: ignored"),
-                        );
+                // An image's RGB, read linear (8-bit decoded from sRGB) and clamped at its
+                // edges as pbrt-v4's `BilerpChannel` does, is the radiance, times `scale`.
+                let image = match self.string(&params, "filename")? {
+                    None => None,
+                    Some(_) if params.get("L").is_some() => {
+                        return Err(self.error(
+                            loc,
+                            "both \"L\" and \"filename\" given for a diffuse area light",
+                        ))
                     }
+                    Some((file, floc)) => {
+                        let path = self.path_in(floc.file, file);
+                        let fallback = "the light emits white instead";
+                        let clamp = Wrap::Clamp;
+                        self.image(&path, &floc, fallback, false, |c| c, [1.0, 1.0], clamp)?
+                    }
+                };
+                let power = match params.get("power") {
+                    None => None,
+                    Some(_) => Some(self.float(&params, "power", -1.0)?).filter(|&w| w > 0.0),
+                };
+                if let Some(q) = params.get("alpha") {
+                    let l = q.loc.clone();
+                    self.warn(&l, "`alpha` of an area light is not supported: ignored");
                 }
                 self.state.area_light = Some(AreaLight {
                     radiance,
                     spectrum,
                     two_sided,
+                    image,
+                    power,
                 });
             }
             "Shape" => {
@@ -1696,35 +1793,18 @@ impl Parser {
                         ))
                     }
                 };
-                let read = if linear {
-                    plenum_image::read_data_texture(&path)
-                } else {
-                    plenum_image::read_texture(&path)
+                let texel = |c: Color| {
+                    let c = c * scale;
+                    if invert {
+                        Color::new(1.0 - c.r, 1.0 - c.g, 1.0 - c.b)
+                    } else {
+                        c
+                    }
                 };
-                match read {
-                    Ok(texels) => {
-                        let (width, height) = (texels.width, texels.height);
-                        let texels: Vec<Color> = texels
-                            .rgb
-                            .iter()
-                            .map(|t| {
-                                let c = Color::new(t[0] as f64, t[1] as f64, t[2] as f64) * scale;
-                                if invert {
-                                    Color::new(1.0 - c.r, 1.0 - c.g, 1.0 - c.b)
-                                } else {
-                                    c
-                                }
-                            })
-                            .collect();
-                        match ImageTexture::new(width, height, texels, scale_uv) {
-                            Some(i) => Texture::Image(Arc::new(i.with_wrap([wrap; 2]))),
-                            None => return Err(self.error(&floc, "the image is empty")),
-                        }
-                    }
-                    Err(e) => {
-                        self.warn(&floc, format!("{e}: a neutral grey (0.5) instead"));
-                        Texture::Constant(Color::gray(0.5))
-                    }
+                let fallback = "a neutral grey (0.5) instead";
+                match self.image(&path, &floc, fallback, linear, texel, scale_uv, wrap)? {
+                    Some(image) => image,
+                    None => Texture::Constant(Color::gray(0.5)),
                 }
             }
             "checkerboard" => {
@@ -1956,10 +2036,80 @@ impl Parser {
                     }
                 }
             }
-            "goniometric" | "projection" => {
-                self.warn(loc, format!("the `{ty}` light is not supported: skipped"));
-                p.list.iter().for_each(|q| q.used.set(true));
-                return Ok(());
+            "goniometric" => {
+                let (c, s) = self.emission(p, "I")?;
+                let position = t.point(Vec3::ZERO);
+                let Some((file, floc)) = self.string(p, "filename")? else {
+                    self.warn(
+                        loc,
+                        "a goniometric light without a \"filename\": a point light",
+                    );
+                    let k = power(self, 4.0 * std::f64::consts::PI)?;
+                    self.builder.add_light(
+                        name,
+                        Light::Point {
+                            position,
+                            intensity: c * k,
+                            attenuation: Attenuation::default(),
+                        },
+                    );
+                    if let Some((s, x)) = s {
+                        self.builder.set_last_light_spectrum(s, x * k);
+                    }
+                    return Ok(());
+                };
+                let path = self.path_in(floc.file, file);
+                let texels = plenum_image::read_texture(&path)
+                    .map_err(|e| self.error(&floc, e.to_string()))?;
+                if texels.width != texels.height {
+                    return Err(self.error(
+                        &floc,
+                        format!(
+                            "a goniometric diagram must be square (equal-area), got {} × {}",
+                            texels.width, texels.height
+                        ),
+                    ));
+                }
+                // pbrt-v4 keeps the mean of the channels, in the frame with y and z swapped.
+                let grey = texels.rgb.iter().map(|t| (t[0] + t[1] + t[2]) as f64 / 3.0);
+                let frame = light_frame(&t, [Vec3::X, Vec3::Z, Vec3::Y]);
+                let profile = Profile::goniometric(texels.width, grey.collect(), frame)
+                    .map_err(|e| self.error(&floc, e))?;
+                let k = power(self, profile.screen_integral())?;
+                (
+                    Light::Profiled {
+                        position,
+                        intensity: c * k,
+                        profile: Arc::new(profile),
+                    },
+                    s.map(|(s, x)| (s, x * k)),
+                )
+            }
+            "projection" => {
+                let scale = self.float(p, "scale", 1.0)?;
+                let fov = self.float(p, "fov", 90.0)?;
+                let Some((file, floc)) = self.string(p, "filename")? else {
+                    return Err(self.error(loc, "a projection light needs a \"string filename\""));
+                };
+                let path = self.path_in(floc.file, file);
+                let texels = plenum_image::read_texture(&path)
+                    .map_err(|e| self.error(&floc, e.to_string()))?;
+                let rgb = texels.rgb.iter();
+                let rgb = rgb.map(|t| Color::new(t[0] as f64, t[1] as f64, t[2] as f64));
+                // pbrt-v4 turns y over: the image's top row toward the light's +y.
+                let frame = light_frame(&t, [Vec3::X, -Vec3::Y, Vec3::Z]);
+                let profile =
+                    Profile::projection(texels.width, texels.height, rgb.collect(), fov, frame)
+                        .map_err(|e| self.error(loc, e))?;
+                let k = power(self, profile.screen_integral())?;
+                (
+                    Light::Profiled {
+                        position: t.point(Vec3::ZERO),
+                        intensity: Color::gray(scale * k),
+                        profile: Arc::new(profile),
+                    },
+                    None,
+                )
             }
             other => {
                 return Err(self.unknown(
@@ -2058,6 +2208,29 @@ impl Parser {
         };
         for key in ["S", "faceIndices"] {
             p.get(key);
+        }
+        // Bilinear patches without uv have pbrt's (u, v) over each: (0, 0) at p00, (1, 0) at
+        // p10, (0, 1) at p01. Each patch then has corners of its own.
+        let in_range = indices.iter().all(|&i| (i as usize) < positions.len());
+        let normals_in_range = normals.is_empty() || normals.len() == positions.len();
+        if per == 4 && uvs.is_empty() && in_range && normals_in_range {
+            let corner = |k: usize| indices[k] as usize;
+            let unshared: Vec<usize> = (0..indices.len()).map(corner).collect();
+            let positions = unshared.iter().map(|&i| positions[i]).collect();
+            let normals = match normals.is_empty() {
+                true => Vec::new(),
+                false => unshared.iter().map(|&i| normals[i]).collect(),
+            };
+            let square = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]];
+            let uvs = (0..indices.len()).map(|k| square[k % 4]).collect();
+            let mut triangles: Vec<[u32; 3]> = (0..indices.len() as u32 / 4)
+                .flat_map(|f| [[4 * f, 4 * f + 1, 4 * f + 3], [4 * f, 4 * f + 3, 4 * f + 2]])
+                .collect();
+            if reverse {
+                triangles.iter_mut().for_each(|t| t.swap(1, 2));
+            }
+            return TriangleMesh::new(positions, triangles, normals, uvs)
+                .map_err(|e| self.error(&pq.loc, e.to_string()));
         }
         TriangleMesh::new(positions, triangles, normals, uvs)
             .map_err(|e| self.error(&pq.loc, e.to_string()))
@@ -2277,8 +2450,8 @@ impl Parser {
                             "a {ty} cannot be an area light in Plenum: placed without emitting"
                         ),
                     );
-                } else if let Some((s, k)) = a.spectrum {
-                    self.builder.set_last_light_spectrum(s, k);
+                } else {
+                    self.finish_area_light(a, loc);
                 }
                 if moves {
                     self.warn(loc, "a moving area light is not supported: it stays at its start-time transformation");

@@ -276,6 +276,20 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
                     atten(attenuation)
                 );
             }
+            Light::Profiled {
+                position,
+                intensity,
+                profile,
+            } => {
+                // The native format has no profiles: the mean intensity, from the point.
+                let _ = writeln!(
+                    w,
+                    "# a goniometric or projection light, written as a point light of its mean intensity\ntype = \"point\"\nposition = {}\n{}\nintensity = {:?}\n",
+                    vec(*position),
+                    emission(scene, i, *intensity, "color"),
+                    profile.mean_luminance()
+                );
+            }
             Light::Directional {
                 direction,
                 intensity,

@@ -579,3 +579,35 @@ fn the_normal_texture_turns_the_shading_normal_in_its_tangent_frame() {
     let want = unit(decode(64), decode(128), decode(221));
     assert!((got - want).length() < 1e-6, "shifted: {got:?} vs {want:?}");
 }
+
+#[test]
+fn the_emissive_texture_times_its_factor_is_the_radiance() {
+    // Quadrants red, green / blue, white (sRGB 255, linear 1), each 2 × 2 texels so that
+    // filtering inside them keeps their colour; the factor (1, 0.5, 2) times strength 1.5.
+    let (r, g, b, w) = ([255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]);
+    let rows = [[r, r, g, g], [r, r, g, g], [b, b, w, w], [b, b, w, w]];
+    let texels: Vec<u8> = rows.iter().flatten().flatten().copied().collect();
+    let l = textured_square(
+        r#"{"emissiveFactor": [1, 0.5, 2], "emissiveTexture": {"index": 0},
+            "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1.5}},
+            "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}}"#,
+        &png(4, 4, 3, &texels),
+    );
+    let image = draw(&l, &path_settings(&l, 1, ColorMode::Rgb, 3));
+    // glTF's (0, 0) is the image's top-left corner, on the square's top-left corner.
+    let k = [1.5, 0.75, 3.0];
+    for ((x, y), want) in [
+        ((8, 8), [k[0], 0.0, 0.0]),
+        ((24, 8), [0.0, k[1], 0.0]),
+        ((8, 24), [0.0, 0.0, k[2]]),
+        ((24, 24), k),
+    ] {
+        let got = image[y * 32 + x];
+        for c in 0..3 {
+            assert!(
+                (got[c] as f64 - want[c]).abs() < 1e-3,
+                "({x}, {y}): {got:?} for {want:?}"
+            );
+        }
+    }
+}

@@ -610,3 +610,41 @@ fn bitmap_wrap_modes() {
         }
     }
 }
+
+/// An `area` emitter's `radiance` may be a texture: a bitmap on a rectangle shows as the
+/// rectangle's (u, v) places it, the bitmap's first row at v = 0 (the rectangle's bottom).
+#[test]
+fn a_bitmap_radiance_varies_over_the_emitter() {
+    // Quadrants red, green / blue, white, each 2 × 2 texels (filtering keeps their colour).
+    let (r, g, b, w) = ([255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]);
+    let rows = [[r, r, g, g], [r, r, g, g], [b, b, w, w], [b, b, w, w]];
+    let texels: Vec<u8> = rows.iter().flatten().flatten().copied().collect();
+    let lamp = png(4, 4, 3, &texels);
+    let text = r#"<scene version="3.0.0">
+  <sensor type="orthographic">
+    <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/><rfilter type="box"/></film>
+  </sensor>
+  <shape type="rectangle">
+    <emitter type="area"><texture type="bitmap" name="radiance"><string name="filename" value="lamp.png"/></texture></emitter>
+  </shape>
+</scene>"#;
+    let l = load_files(&[("scene.xml", text.as_bytes()), ("lamp.png", &lamp[..])])
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    let image = draw(&l, &path_settings(&l, 1, ColorMode::Rgb, 1));
+    for ((x, y), want) in [
+        ((8, 8), [0.0, 0.0, 1.0]),
+        ((24, 8), [1.0, 1.0, 1.0]),
+        ((8, 24), [1.0, 0.0, 0.0]),
+        ((24, 24), [0.0, 1.0, 0.0]),
+    ] {
+        let got = image[y * 32 + x];
+        for c in 0..3 {
+            assert!(
+                (got[c] as f64 - want[c]).abs() < 1e-3,
+                "({x}, {y}): {got:?} for {want:?}"
+            );
+        }
+    }
+}

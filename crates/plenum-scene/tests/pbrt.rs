@@ -7,7 +7,7 @@ mod common;
 
 use common::{bright_centre, load_files, native, number, png};
 
-use common::integrators::{cbox_z_test_of, draw, path_settings};
+use common::integrators::{cbox_z_test_of, draw, path_settings, settings_for};
 use plenum_core::integrator::{ColorMode, IntegratorKind};
 use plenum_scene::{load_scene, LoadedScene, SceneError};
 use std::path::PathBuf;
@@ -866,4 +866,196 @@ Shape "sphere"
         "{VIEW}Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"x.png\" \"string wrap\" \"tile\"\n"
     ));
     assert!(e.message.contains("unknown wrap `tile`"), "{e}");
+}
+
+#[test]
+fn image_area_lights_show_their_image_scaled_to_their_power() {
+    // Red, green / blue, white, as the file stores its rows (top first); 8-bit, so sRGB.
+    let image = png(2, 2, 3, &[255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255]);
+    let render = |light: &str| {
+        let text = format!(
+            r#"{VIEW}AttributeBegin
+  AreaLightSource "diffuse" {light}
+  Translate 0 0 3
+  Shape "bilinearmesh" "point3 P" [ -1 -1 0  -1 1 0  1 -1 0  1 1 0 ] "integer indices" [ 0 1 2 3 ]
+AttributeEnd
+"#
+        );
+        let l = load_files(&[("scene.pbrt", text.as_bytes()), ("lamp.png", &image[..])])
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        // Near the corners, past the texels' centres, where the clamped lookup is one texel.
+        let image = draw(&l, &path_settings(&l, 1, ColorMode::Rgb, 1));
+        [(8, 8), (23, 8), (8, 23), (23, 23)].map(|(x, y)| image[y * 32 + x])
+    };
+    let close = |got: [f32; 3], want: [f64; 3], what: &str| {
+        for c in 0..3 {
+            assert!(
+                (got[c] as f64 - want[c]).abs() < 1e-3,
+                "{what}: {got:?} for {want:?}"
+            );
+        }
+    };
+    // The patch (facing the camera) has u along +y and v along +x; pbrt-v4 looks its image
+    // up at (u, 1 − v) from the file's top-left corner. So the screen's top-left corner
+    // (u near 1, v near 0) shows the file's bottom-right texel, and so on.
+    let corners = render(r#""string filename" "lamp.png" "float scale" 2"#);
+    let want = [
+        [2.0, 2.0, 2.0],
+        [0.0, 2.0, 0.0],
+        [0.0, 0.0, 2.0],
+        [2.0, 0.0, 0.0],
+    ];
+    for (got, want) in corners.into_iter().zip(want) {
+        close(got, want, "scale 2");
+    }
+    // `power` 10 W over a one-sided area of 4 whose image has mean luminance ½: radiance
+    // 10 / (π · 4 · ½) per unit of image, times `scale`.
+    let k = 2.0 * 10.0 / (std::f64::consts::PI * 2.0);
+    let corners = render(r#""string filename" "lamp.png" "float scale" 2 "float power" 10"#);
+    close(corners[3], [k, 0.0, 0.0], "power");
+    close(corners[0], [k, k, k], "power");
+    // With `L`, pbrt-v4 divides the power by π, the area and the sides alone.
+    let corners = render(r#""rgb L" [ 1 2 3 ] "float power" 25.132741228718345"#);
+    close(corners[1], [2.0, 4.0, 6.0], "power of an rgb L");
+    let e = error(&format!(
+        "{VIEW}AreaLightSource \"diffuse\" \"rgb L\" [1 1 1] \"string filename\" \"lamp.png\"\n"
+    ));
+    assert!(e.message.contains("both \"L\" and \"filename\""), "{e}");
+}
+
+/// The mean of `f` over pixel (x, y) of a 16 × 16 view spanning [−1, 1]² (x right, y up),
+/// by 16 × 16 points: what a box filter converges to.
+fn pixel_mean(x: usize, y: usize, f: impl Fn(f64, f64) -> f64) -> f64 {
+    let mut sum = 0.0;
+    for (i, j) in (0..256).map(|k| (k % 16, k / 16)) {
+        let sx = (x as f64 + (i as f64 + 0.5) / 16.0) / 8.0 - 1.0;
+        let sy = 1.0 - (y as f64 + (j as f64 + 0.5) / 16.0) / 8.0;
+        sum += f(sx, sy);
+    }
+    sum / 256.0
+}
+
+/// The wall's radiance ρ/π · I · cos θ / d² at the screen point (sx, sy) (units of tan 30°)
+/// of a light at the origin lighting the wall z = 2, seen from the origin.
+fn on_the_wall(sx: f64, sy: f64, intensity: f64) -> f64 {
+    let t = (30f64).to_radians().tan();
+    let (x, y) = (2.0 * sx * t, 2.0 * sy * t);
+    let d2 = x * x + y * y + 4.0;
+    0.5 / std::f64::consts::PI * intensity * (2.0 / d2.sqrt()) / d2
+}
+
+#[test]
+fn a_projection_light_casts_its_image_upright() {
+    // Red, green / blue, white; 60° across, from the camera's place onto a wall at z = 2
+    // that the camera's 60° view fills: each quadrant of the picture lit by one texel.
+    let image = png(2, 2, 3, &[255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255]);
+    let render = |light: &str| {
+        let text = format!(
+            r#"LookAt 0 0 0  0 0 1  0 1 0
+Camera "perspective" "float fov" 60
+Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+Sampler "independent" "integer pixelsamples" 1024
+WorldBegin
+LightSource "projection" "string filename" "slide.png" "float fov" 60 {light}
+Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+Shape "bilinearmesh" "point3 P" [ -5 -5 2  -5 5 2  5 -5 2  5 5 2 ] "integer indices" [ 0 1 2 3 ]
+"#
+        );
+        let l = load_files(&[("scene.pbrt", text.as_bytes()), ("slide.png", &image[..])])
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        draw(&l, &path_settings(&l, 1024, ColorMode::Rgb, 1))
+    };
+    // Pixels (4, 4) … near the quadrants' centres, each inside one texel's light; 1024 spp
+    // at random in the pixel, box filter, seed 1, within 1 % of the pixel's mean.
+    let check = |picture: &[[f32; 3]], scale: f64, what: &str| {
+        for ((x, y), colour) in [
+            ((4, 4), [1.0, 0.0, 0.0]),
+            ((11, 4), [0.0, 1.0, 0.0]),
+            ((4, 11), [0.0, 0.0, 1.0]),
+            ((11, 11), [1.0, 1.0, 1.0]),
+        ] {
+            let want = pixel_mean(x, y, |sx, sy| on_the_wall(sx, sy, scale));
+            let got = picture[y * 16 + x];
+            for c in 0..3 {
+                let w = want * colour[c];
+                assert!(
+                    (got[c] as f64 - w).abs() <= 0.01 * want,
+                    "{what}: pixel ({x}, {y}) {got:?}, channel {c} should be {w:.5}"
+                );
+            }
+        }
+    };
+    check(&render(r#""float scale" 3"#), 3.0, "scale 3");
+    every_method_agrees(&format!(
+        "{}LightSource \"projection\" \"string filename\" \"slide.png\" \"float fov\" 60\n{}",
+        "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 60\nWorldBegin\n",
+        "Material \"diffuse\"\nShape \"bilinearmesh\" \"point3 P\" [ -5 -5 2  -5 5 2  5 -5 2  5 5 2 ] \"integer indices\" [ 0 1 2 3 ]\n"
+    ), ("slide.png", &image));
+    // `power` over ∫ Y dω of the image, by pbrt-v4's sum over texels (centres at screen
+    // (±0.5, ±0.5), each of area tan² 30°, seen at cos³ θ).
+    let t2 = (30f64).to_radians().tan().powi(2);
+    let cos3 = (1.0 / (1.0 + 0.5 * t2)).powf(1.5);
+    let luminance = 0.2126 + 0.7152 + 0.0722 + 1.0;
+    let k = 5.0 / (luminance * cos3 * t2);
+    check(&render(r#""float power" 5"#), k, "power 5");
+}
+
+#[test]
+fn a_goniometric_light_shines_by_its_diagram() {
+    // The diagram's four texels (the mean of their channels) cover the four quarters of
+    // the sphere split by the light's x and y, which pbrt-v4 swaps with z: world x and z.
+    // Texels: (1/3, 2/3 / 1, 0) from the top-left; u follows +x, v (down the image) +z.
+    let diagram = png(2, 2, 3, &[255, 0, 0, 255, 255, 0, 255, 255, 255, 0, 0, 0]);
+    let text = r#"LookAt 0 5 0  0 -1 0  0 0 1
+Camera "perspective" "float fov" 60
+Film "rgb" "integer xresolution" 16 "integer yresolution" 16
+Sampler "independent" "integer pixelsamples" 1024
+WorldBegin
+LightSource "goniometric" "string filename" "lamp.png" "rgb I" [ 2 2 2 ]
+Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+Shape "bilinearmesh" "point3 P" [ -9 -1 -9  9 -1 -9  -9 -1 9  9 -1 9 ] "integer indices" [ 0 1 2 3 ]
+"#;
+    let l = load_files(&[("scene.pbrt", text.as_bytes()), ("lamp.png", &diagram[..])])
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    every_method_agrees(text, ("lamp.png", &diagram));
+    let picture = draw(&l, &path_settings(&l, 1024, ColorMode::Rgb, 1));
+    // The camera 6 above the floor sees ±6 tan 30° of it, x to the right and z up: each
+    // pixel within 1 % of its mean (1024 spp at random, box filter, seed 1).
+    let half = 6.0 * (30f64).to_radians().tan();
+    for ((x, y), factor) in [
+        ((4, 4), 1.0),
+        ((11, 4), 0.0),
+        ((4, 11), 1.0 / 3.0),
+        ((11, 11), 2.0 / 3.0),
+    ] {
+        let want = pixel_mean(x, y, |sx, sy| {
+            let d2 = (sx * half).powi(2) + (sy * half).powi(2) + 1.0;
+            0.5 / std::f64::consts::PI * 2.0 * factor / d2.powf(1.5)
+        });
+        let got = picture[y * 16 + x][1] as f64;
+        assert!(
+            (got - want).abs() <= 0.01 * want.max(1e-3),
+            "pixel ({x}, {y}): {got:.5}, want {want:.5}"
+        );
+    }
+}
+
+/// Light tracing and BDPT, which start paths at a light by its own sampling, agree with the
+/// path tracer on the image's mean within 2 % (16 × 16 pixels; 256 spp for BDPT, 1024 for
+/// light tracing, 64 for the path tracer; RGB, seed 9).
+fn every_method_agrees(text: &str, file: (&str, &[u8])) {
+    let l = load_files(&[("scene.pbrt", text.as_bytes()), file]).unwrap_or_else(|e| panic!("{e}"));
+    let mut l = l;
+    l.defaults.width = 16;
+    l.defaults.height = 16;
+    let mean = |kind, spp| {
+        common::integrators::mean(&draw(&l, &settings_for(&l, kind, spp, ColorMode::Rgb, 9)))
+    };
+    let path = mean(IntegratorKind::Path, 64);
+    for (kind, spp) in [(IntegratorKind::Bdpt, 256), (IntegratorKind::Light, 1024)] {
+        common::integrators::assert_mean_within(kind.name(), mean(kind, spp), "path", path, 0.02);
+    }
 }

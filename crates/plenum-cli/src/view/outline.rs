@@ -61,7 +61,9 @@ pub fn scene_json(scene: &Scene, width: u32, height: u32) -> Value {
         .iter()
         .zip(&scene.lights.names)
         .filter_map(|(light, name)| match light {
-            Light::Point { position, .. } | Light::Spot { position, .. } => {
+            Light::Point { position, .. }
+            | Light::Spot { position, .. }
+            | Light::Profiled { position, .. } => {
                 Some(json!({ "name": name, "position": xyz(*position) }))
             }
             Light::Directional { direction, .. } => {

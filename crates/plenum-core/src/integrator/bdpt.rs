@@ -309,8 +309,10 @@ impl<'a> BidirectionalPathTracer<'a> {
             l += v.beta * v.le;
         }
         let max_vertices = self.max_depth as usize + 3;
+        // s = 1 samples a light afresh: it counts even where no light subpath began (a
+        // direction the light sends nothing along, which its weight still expects).
         for t in 1..=camera_path.len() {
-            for s in 0..=light_path.len() {
+            for s in 0..=light_path.len().max(1) {
                 if s + t < 2 || s + t > max_vertices || (s == 1 && t == 1) {
                     continue;
                 }

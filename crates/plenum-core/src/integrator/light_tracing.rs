@@ -178,14 +178,15 @@ impl<'a> LightTracer<'a> {
         let q = es.ray.origin;
         let c = self.camera.sample_wi(q, u_lens, time)?;
         // c.wi points from q toward the lens.
-        let geometric = match es.n {
+        // A surface's radiance is the sample's; a point's varies with the direction.
+        let (geometric, radiance) = match es.n {
             Some(n) => {
                 if !light.emits_toward(n, c.wi) {
                     return None;
                 }
-                n.dot(c.wi).abs() / es.pdf.pos
+                (n.dot(c.wi).abs() / es.pdf.pos, es.radiance)
             }
-            None => light.spot_falloff(c.wi),
+            None => light.point_emission(c.wi),
         };
         if geometric <= 0.0 {
             return None;
@@ -200,7 +201,7 @@ impl<'a> LightTracer<'a> {
         {
             return None;
         }
-        let l = match es.radiance {
+        let l = match radiance {
             Some(c) => rgb_radiance(c, wl),
             None => self.scene.lights.spectrum(index, wl),
         };

@@ -43,7 +43,10 @@ pub struct EmissionPdf {
 impl Light {
     /// The origin is a point (point and spot lights): no strategy can hit it.
     pub fn is_delta_position(&self) -> bool {
-        matches!(self, Light::Point { .. } | Light::Spot { .. })
+        matches!(
+            self,
+            Light::Point { .. } | Light::Spot { .. } | Light::Profiled { .. }
+        )
     }
 
     /// The direction is fixed (directional lights).
@@ -111,7 +114,7 @@ impl Light {
                 ..
             } => {
                 let d = Frame::from_z(direction).to_world(uniform_cone(u_dir, cos_outer));
-                let scale = self.spot_falloff(d);
+                let (scale, _) = self.point_emission(d);
                 Some(sample(
                     position,
                     d,
@@ -121,6 +124,15 @@ impl Light {
                     1.0,
                     uniform_cone_pdf(cos_outer),
                 ))
+            }
+            Light::Profiled {
+                position,
+                ref profile,
+                ..
+            } => {
+                let (d, pdf) = profile.sample(u_dir);
+                let (scale, radiance) = self.point_emission(d);
+                (pdf > 0.0).then(|| sample(position, d, None, scale, radiance, 1.0, pdf))
             }
             Light::Directional { direction, .. } => {
                 let (o, pos) = entry_disk(-direction, u_pos, center, radius);
@@ -177,6 +189,10 @@ impl Light {
                     0.0
                 },
             },
+            Light::Profiled { ref profile, .. } => EmissionPdf {
+                pos: 1.0,
+                dir: profile.pdf(d),
+            },
             Light::Directional { .. } => EmissionPdf {
                 pos: disk,
                 dir: 1.0,
@@ -188,16 +204,33 @@ impl Light {
         }
     }
 
-    /// A spot light's smooth falloff toward the unit direction `d` (1 for other lights).
-    pub fn spot_falloff(&self, d: Vec3) -> f64 {
+    /// What a light that is a point sends toward the unit direction `d`: a factor on its
+    /// spectrum (a spot's smooth falloff, a goniometric diagram's value), or an RGB
+    /// intensity in place of its spectrum (a projected image's colour times the light's
+    /// intensity). (1, None) for other lights.
+    pub fn point_emission(&self, d: Vec3) -> (f64, Option<Color>) {
         match *self {
             Light::Spot {
                 direction,
                 cos_inner,
                 cos_outer,
                 ..
-            } => super::smoothstep(cos_outer, cos_inner, d.dot(direction)),
-            _ => 1.0,
+            } => (
+                super::smoothstep(cos_outer, cos_inner, d.dot(direction)),
+                None,
+            ),
+            Light::Profiled {
+                intensity,
+                ref profile,
+                ..
+            } => {
+                let f = profile.factor(d);
+                match profile.is_grey() {
+                    true => (f.r, None),
+                    false => (1.0, Some(intensity * f)),
+                }
+            }
+            _ => (1.0, None),
         }
     }
 }

@@ -18,8 +18,10 @@ use crate::sampling::{
 use std::sync::Arc;
 
 mod emission;
+mod profile;
 mod textured;
 pub use emission::{EmissionPdf, EmissionSample};
+pub use profile::Profile;
 pub use textured::EmissionTexture;
 use textured::EmitterPoint;
 
@@ -63,6 +65,13 @@ pub enum Light {
     },
     /// A light at infinity shining along `direction` (unit).
     Directional { direction: Vec3, intensity: Color },
+    /// A point light whose intensity varies with direction by `profile` (a goniometric
+    /// diagram or a projected image), with the inverse-square law of physics.
+    Profiled {
+        position: Vec3,
+        intensity: Color,
+        profile: Arc<Profile>,
+    },
     /// A point light limited to a cone, fading smoothly from the inner to the outer angle.
     Spot {
         position: Vec3,
@@ -557,28 +566,30 @@ impl Light {
                     shadow_end: f64::INFINITY,
                 })
             }
-            Light::Point { position, .. } | Light::Spot { position, .. } => {
-                let inc = self.incident(p, u)?;
-                let falloff = match *self {
-                    Light::Spot {
-                        direction,
-                        cos_inner,
-                        cos_outer,
-                        ..
-                    } => smoothstep(cos_outer, cos_inner, (-inc.wi).dot(direction)),
-                    _ => 1.0,
-                };
-                let d2 = (position - p).length_squared();
+            Light::Point { position, .. }
+            | Light::Spot { position, .. }
+            | Light::Profiled { position, .. } => {
+                let to = position - p;
+                let d2 = to.length_squared();
+                let d = d2.sqrt();
+                if d == 0.0 {
+                    return None;
+                }
+                let wi = to / d;
+                let (factor, radiance) = self.point_emission(-wi);
+                if factor <= 0.0 || radiance.is_some_and(Color::is_black) {
+                    return None;
+                }
                 Some(LightSample {
-                    wi: inc.wi,
-                    distance: inc.distance,
-                    position: inc.position,
+                    wi,
+                    distance: d,
+                    position: Some(position),
                     normal: None,
-                    scale: falloff / d2,
+                    scale: factor / d2,
                     pdf: 1.0,
                     delta: true,
-                    radiance: None,
-                    shadow_end: inc.shadow_end,
+                    radiance: radiance.map(|c| c / d2),
+                    shadow_end: POINT_SHADOW_END,
                 })
             }
             Light::Directional { direction, .. } => Some(LightSample {
@@ -633,6 +644,9 @@ impl Light {
         use std::f64::consts::PI;
         match self {
             Light::Point { intensity, .. } => 4.0 * PI * intensity.luminance(),
+            Light::Profiled {
+                intensity, profile, ..
+            } => 4.0 * PI * intensity.luminance() * profile.mean_luminance(),
             Light::Spot {
                 intensity,
                 cos_inner,
@@ -690,6 +704,7 @@ impl Light {
         match self {
             Light::Point { intensity, .. }
             | Light::Spot { intensity, .. }
+            | Light::Profiled { intensity, .. }
             | Light::Directional { intensity, .. } => *intensity = c,
             Light::Area { radiance, .. }
             | Light::Infinite { radiance }
@@ -702,6 +717,7 @@ impl Light {
         match *self {
             Light::Point { intensity, .. }
             | Light::Spot { intensity, .. }
+            | Light::Profiled { intensity, .. }
             | Light::Directional { intensity, .. } => intensity,
             Light::Area { radiance, .. }
             | Light::Infinite { radiance }
@@ -744,6 +760,29 @@ impl Light {
                     distance: d,
                     position: Some(position),
                     intensity: intensity * attenuation.factor(d),
+                    shadow_end: POINT_SHADOW_END,
+                })
+            }
+            Light::Profiled {
+                position,
+                intensity,
+                ..
+            } => {
+                let to = position - p;
+                let d = to.length();
+                if d == 0.0 {
+                    return None;
+                }
+                let wi = to / d;
+                let intensity = match self.point_emission(-wi) {
+                    (_, Some(c)) => c,
+                    (k, None) => intensity * k,
+                };
+                (!intensity.is_black()).then_some(Incident {
+                    wi,
+                    distance: d,
+                    position: Some(position),
+                    intensity,
                     shadow_end: POINT_SHADOW_END,
                 })
             }

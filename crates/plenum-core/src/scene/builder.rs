@@ -51,6 +51,18 @@ impl SceneBuilder {
         }
     }
 
+    /// The last light added.
+    pub fn last_light(&self) -> Option<&Light> {
+        self.lights.last()
+    }
+
+    /// Multiplies the RGB value (radiance or intensity) of the last light added by `k`.
+    pub fn scale_last_light(&mut self, k: f64) {
+        if let Some(l) = self.lights.last_mut() {
+            l.set_rgb(l.rgb() * k);
+        }
+    }
+
     /// Makes the last light added, an area light, emit only toward its normal's side.
     pub fn set_last_light_one_sided(&mut self) {
         if let Some(Light::Area { two_sided, .. }) = self.lights.last_mut() {
