@@ -394,9 +394,13 @@ impl<'a> Reader<'a> {
                 .collect(),
             None => Vec::new(),
         };
-        if p.get(&gltf::Semantic::Tangents).is_some() && p.material().normal_texture().is_some() {
-            self.warn(format!("{at}: TANGENT is not read: the normal map's tangents follow the texture coordinates across each triangle"));
-        }
+        // Tangents, for a normal map's frame: read where one uses them.
+        let tangents: Vec<[f64; 4]> = match p.get(&gltf::Semantic::Tangents) {
+            Some(t) if p.material().normal_texture().is_some() => {
+                self.floats::<4>(&t, "TANGENT")?
+            }
+            _ => Vec::new(),
+        };
         let index: Vec<u32> = match p.indices() {
             Some(i) => self.indices(&i)?,
             None => (0..positions.len() as u32).collect(),
@@ -418,8 +422,11 @@ impl<'a> Reader<'a> {
                 .map(|i| [index[0], index[i - 1], index[i]])
                 .collect(),
         };
-        let m = TriangleMesh::new(positions, triangles, normals, uvs)
+        let mut m = TriangleMesh::new(positions, triangles, normals, uvs)
             .map_err(|e| self.error(&at, e))?;
+        if !tangents.is_empty() {
+            m = m.with_tangents(tangents).map_err(|e| self.error(&at, e))?;
+        }
         let m = Some(Arc::new(m));
         self.meshes.insert(key, m.clone());
         Ok(m)

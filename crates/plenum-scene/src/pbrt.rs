@@ -554,6 +554,9 @@ fn column_major(n: &[f64]) -> Matrix4 {
     m
 }
 
+/// The (u, v) pbrt-v4 gives the corners of a triangle without uv.
+const PBRT_TRIANGLE_UVS: [[f64; 2]; 3] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]];
+
 /// The orthonormal frame whose axes are the light-space directions `axes` placed by `t`
 /// (pbrt-v4 composes a swap or a flip into some lights' transformations).
 fn light_frame(t: &Transform, axes: [Vec3; 3]) -> Frame {
@@ -2232,7 +2235,12 @@ impl Parser {
             return TriangleMesh::new(positions, triangles, normals, uvs)
                 .map_err(|e| self.error(&pq.loc, e.to_string()));
         }
+        // pbrt's triangles without uv: (0, 0), (1, 0), (1, 1) at their corners, in the order
+        // given (reversed above, so turned back here).
+        let [a, b, c] = PBRT_TRIANGLE_UVS;
+        let corners = if reverse { [a, c, b] } else { [a, b, c] };
         TriangleMesh::new(positions, triangles, normals, uvs)
+            .map(|m| m.with_corner_uvs(corners))
             .map_err(|e| self.error(&pq.loc, e.to_string()))
     }
 
@@ -2365,7 +2373,7 @@ impl Parser {
                 if reverse {
                     self.warn(loc, "ReverseOrientation on a one-sided PLY light is not supported: it emits as its faces are wound");
                 }
-                Shape::Mesh(Arc::new(mesh))
+                Shape::Mesh(Arc::new(mesh.with_corner_uvs(PBRT_TRIANGLE_UVS)))
             }
             "curve" => {
                 self.warn(loc, "curves are not supported: skipped");

@@ -611,3 +611,79 @@ fn the_emissive_texture_times_its_factor_is_the_radiance() {
         }
     }
 }
+
+/// A square facing +z with normals and the tangent `tangent` at every vertex, its
+/// material a normal map of the one texel `texel`: the shading normal at its centre.
+fn normal_from_tangents(tangent: [f32; 4], texel: [u8; 3]) -> plenum_core::math::Vec3 {
+    use plenum_core::math::{Ray, Vec3};
+    let corners = [[-0.5f32, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]];
+    let mut buffer = Vec::new();
+    let mut put = |values: &[f32]| values.iter().for_each(|v| buffer.extend(v.to_le_bytes()));
+    corners.iter().for_each(|[x, y]| put(&[*x, *y, 0.0]));
+    corners.iter().for_each(|_| put(&[0.0, 0.0, 1.0]));
+    corners.iter().for_each(|[x, y]| put(&[x + 0.5, 0.5 - y]));
+    corners.iter().for_each(|_| put(&tangent));
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        buffer.extend(i.to_le_bytes());
+    }
+    let image = base64(&png(1, 1, 3, &texel));
+    let text = format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "scenes": [{{"nodes": [0]}}],
+  "nodes": [{{"mesh": 0}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2, "TANGENT": 3}}, "indices": 4, "material": 0}}]}}],
+  "materials": [{{"normalTexture": {{"index": 0}}}}],
+  "images": [{{"uri": "data:image/png;base64,{image}"}}],
+  "textures": [{{"source": 0}}],
+  "buffers": [{{"byteLength": 204, "uri": "data:application/octet-stream;base64,{}"}}],
+  "bufferViews": [
+    {{"buffer": 0, "byteOffset": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": 48}},
+    {{"buffer": 0, "byteOffset": 96, "byteLength": 32}}, {{"buffer": 0, "byteOffset": 128, "byteLength": 64}},
+    {{"buffer": 0, "byteOffset": 192, "byteLength": 12}}
+  ],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-0.5, -0.5, 0], "max": [0.5, 0.5, 0]}},
+    {{"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"}},
+    {{"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"}},
+    {{"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC4"}},
+    {{"bufferView": 4, "componentType": 5123, "count": 6, "type": "SCALAR"}}
+  ]
+}}"#,
+        base64(&buffer)
+    );
+    let l = load(&text);
+    assert!(
+        l.warnings.iter().all(|w| !w.contains("TANGENT")),
+        "{:?}",
+        l.warnings
+    );
+    let ray = Ray::new(Vec3::new(0.1, 0.1, 3.0), -Vec3::Z);
+    let (prim, hit) = l.scene.geometry.intersect(&ray, f64::INFINITY).unwrap();
+    l.scene.geometry.interaction(&ray, prim, &hit).shading_n
+}
+
+#[test]
+fn tangent_attributes_give_the_normal_map_its_frame() {
+    // Tangent-space x along the given tangent, y along n × t times its w: a tangent along
+    // +y turns a map tilted to +x toward +y; with w = −1 a map tilted up (+y) leans to +x
+    // (n × t = −x, turned over). With the tangent along +x, what the uvs give.
+    use plenum_core::math::Vec3;
+    let decode = |b: u8| 2.0 * b as f64 / 255.0 - 1.0;
+    // 128 decodes to a hair above 0.
+    let (tilt, flat, z) = (decode(191), decode(128), decode(221));
+    let unit = |x: f64, y: f64| Vec3::new(x, y, z).normalized();
+    for (tangent, texel, want) in [
+        ([0.0, 1.0, 0.0, 1.0], [191, 128, 221], unit(-flat, tilt)),
+        ([0.0, 1.0, 0.0, -1.0], [128, 191, 221], unit(tilt, flat)),
+        ([0.0, 1.0, 0.0, 1.0], [128, 191, 221], unit(-tilt, flat)),
+        ([1.0, 0.0, 0.0, 1.0], [191, 128, 221], unit(tilt, flat)),
+        ([1.0, 0.0, 0.0, 1.0], [128, 191, 221], unit(flat, tilt)),
+    ] {
+        let got = normal_from_tangents(tangent, texel);
+        assert!(
+            (got - want).length() < 1e-6,
+            "tangent {tangent:?}, texel {texel:?}: {got:?} vs {want:?}"
+        );
+    }
+}

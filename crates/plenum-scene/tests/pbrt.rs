@@ -1059,3 +1059,46 @@ fn every_method_agrees(text: &str, file: (&str, &[u8])) {
         common::integrators::assert_mean_within(kind.name(), mean(kind, spp), "path", path, 0.02);
     }
 }
+
+#[test]
+fn triangles_and_bilinear_patches_without_uv_have_pbrts() {
+    use plenum_core::geometry::Shape;
+    use plenum_core::math::Vec3;
+    // pbrt-v4: a triangle's corners at (0, 0), (1, 0), (1, 1); a patch's p00, p10, p01,
+    // p11 at (0, 0), (1, 0), (0, 1), (1, 1). Also when ReverseOrientation turns them.
+    let l = load(
+        r#"WorldBegin
+Shape "trianglemesh" "point3 P" [ 0 0 0  2 0 0  2 2 0 ] "integer indices" [ 0 1 2 ]
+Shape "bilinearmesh" "point3 P" [ 0 0 1  2 0 1  0 2 1  2 2 1 ] "integer indices" [ 0 1 2 3 ]
+ReverseOrientation
+Shape "trianglemesh" "point3 P" [ 0 0 2  2 0 2  2 2 2 ] "integer indices" [ 0 1 2 ]
+"#,
+    );
+    let at = |i: usize, p: Vec3| {
+        let Shape::Mesh(m) = &l.scene.geometry.primitives[i].shape else {
+            panic!("expected a mesh");
+        };
+        // The triangle containing p (of the patch's two), by the part a hit names it by.
+        let (part, _) = m
+            .triangles()
+            .find(|&(k, _)| {
+                let [a, b] = m.barycentrics(k, p);
+                a >= -1e-9 && b >= -1e-9 && a + b <= 1.0 + 1e-9
+            })
+            .unwrap();
+        l.scene.geometry.primitives[i].shape.uv_at(p, part)
+    };
+    let close = |got: [f64; 2], want: [f64; 2]| {
+        assert!(
+            (got[0] - want[0]).abs() < 1e-9 && (got[1] - want[1]).abs() < 1e-9,
+            "{got:?} for {want:?}"
+        );
+    };
+    close(at(0, Vec3::new(2.0, 2.0, 0.0)), [1.0, 1.0]);
+    close(at(0, Vec3::new(2.0, 0.0, 0.0)), [1.0, 0.0]);
+    close(at(0, Vec3::new(1.5, 0.5, 0.0)), [0.75, 0.25]);
+    close(at(1, Vec3::new(0.0, 2.0, 1.0)), [0.0, 1.0]);
+    close(at(1, Vec3::new(1.0, 0.5, 1.0)), [0.5, 0.25]);
+    close(at(2, Vec3::new(2.0, 2.0, 2.0)), [1.0, 1.0]);
+    close(at(2, Vec3::new(2.0, 0.0, 2.0)), [1.0, 0.0]);
+}

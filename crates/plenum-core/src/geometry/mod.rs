@@ -146,7 +146,8 @@ impl Shape {
     }
 
     /// ∂p/∂u and ∂p/∂v at a hit whose geometry is `g` (computed with texture coordinates),
-    /// in the shape's coordinates: the tangent frame of normal and bump maps. Where the
+    /// in the shape's coordinates: the tangent frame of normal and bump maps (a mesh with
+    /// tangents gives its interpolated tangent and bitangent instead). Where the
     /// parametrisation is singular (a sphere's pole, a disk's centre, a triangle with
     /// degenerate uvs) some orthonormal pair around the normal.
     pub fn uv_derivatives(&self, hit: &HitRecord, g: &SurfaceGeometry) -> [Vec3; 2] {
@@ -159,7 +160,10 @@ impl Shape {
             Shape::Cone(s) => s.uv_derivatives(hit, g.p),
             Shape::Polygon(s) => s.uv_derivatives(),
             Shape::Polyhedron(s) => s.uv_derivatives(hit),
-            Shape::Mesh(s) => s.uv_derivatives(hit),
+            // glTF's tangents, where given, in place of the uvs' derivatives.
+            Shape::Mesh(s) => s
+                .tangent_frame(hit)
+                .unwrap_or_else(|| s.uv_derivatives(hit)),
         };
         let spanned = dpdu.cross(dpdv).length_squared();
         if spanned > 1e-24 * dpdu.length_squared() * dpdv.length_squared() && spanned.is_finite() {

@@ -110,3 +110,107 @@ impl PartialEq for EmissionTexture {
         std::ptr::eq(self, o)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{Cuboid, Polygon, Polyhedron, Sphere, TriangleMesh};
+    use crate::math::Ray;
+    use crate::sampling::Rng;
+    use std::sync::Arc;
+
+    /// The (u, v) a sampled point of each emitter gets is the one a ray hitting the shape
+    /// there reports: for a box (each face its own part), a polyhedron, a concave polygon,
+    /// a mesh with uvs (under a mirroring transform, which rewinds the emitter's
+    /// triangles) and a placed sphere.
+    #[test]
+    fn sampled_points_get_the_uv_a_hit_there_gets() {
+        let v = Vec3::new;
+        let octahedron = Polyhedron::new(
+            &[
+                v(1.0, 0.0, 0.0),
+                v(-1.0, 0.0, 0.0),
+                v(0.0, 1.0, 0.0),
+                v(0.0, -1.0, 0.0),
+                v(0.0, 0.0, 1.0),
+                v(0.0, 0.0, -1.0),
+            ],
+            &[
+                vec![0, 2, 4],
+                vec![2, 1, 4],
+                vec![1, 3, 4],
+                vec![3, 0, 4],
+                vec![2, 0, 5],
+                vec![1, 2, 5],
+                vec![3, 1, 5],
+                vec![0, 3, 5],
+            ],
+        )
+        .unwrap();
+        let notch = Polygon::new(vec![
+            v(0.0, 0.0, 0.0),
+            v(2.0, 0.0, 0.0),
+            v(2.0, 2.0, 0.0),
+            v(1.0, 0.7, 0.0),
+            v(0.0, 2.0, 0.0),
+        ])
+        .unwrap();
+        let mesh = TriangleMesh::new(
+            vec![
+                v(0.0, 0.0, 0.0),
+                v(1.0, 0.0, 0.0),
+                v(1.3, 1.0, 0.0),
+                v(0.0, 1.0, 0.0),
+            ],
+            vec![[0, 1, 2], [0, 2, 3]],
+            Vec::new(),
+            vec![[0.1, 0.2], [0.9, 0.1], [0.7, 0.8], [0.2, 0.6]],
+        )
+        .unwrap();
+        let turn = Transform::rotate(v(1.0, 2.0, 0.5), 40.0).unwrap();
+        let mirror = Transform::scale(v(-1.0, 2.0, 1.0)).unwrap().after(&turn);
+        let sphere_place = Transform::translate(v(0.3, -1.0, 2.0))
+            .after(&Transform::scale(Vec3::splat(2.0)).unwrap())
+            .after(&turn);
+        let cases = [
+            (
+                Shape::Cuboid(Cuboid::new(v(-1.0, -0.5, 0.0), v(2.0, 1.0, 0.5))),
+                turn,
+            ),
+            (Shape::Polyhedron(Box::new(octahedron)), turn),
+            (Shape::Polygon(Box::new(notch)), Transform::IDENTITY),
+            (Shape::Mesh(Arc::new(mesh)), mirror),
+            (
+                Shape::Sphere(Sphere::new(v(0.0, 0.0, 0.0), 1.0)),
+                sphere_place,
+            ),
+        ];
+        let mut rng = Rng::new(5, 1);
+        for (shape, to_world) in cases {
+            let emitter = Emitter::of_shape(&shape, &to_world).unwrap();
+            let t =
+                EmissionTexture::new(Texture::Constant(Color::WHITE), &emitter, &shape, &to_world)
+                    .unwrap();
+            let to_object = to_world.inverted();
+            for _ in 0..200 {
+                let (q, n, at) = emitter
+                    .sample_point([rng.uniform(), rng.uniform()])
+                    .unwrap();
+                let got = t.coords(at).uv;
+                // A ray down the normal onto the point, in the shape's coordinates.
+                let (p, d) = (to_object.point(q + n * 1e-3), to_object.vector(-n));
+                let ray = Ray::new(p, d);
+                let hit = shape.intersect(&ray, 1.0).expect("the ray meets the shape");
+                let want = shape.surface(&ray, &hit, true).uv;
+                // u wraps around on the sphere.
+                let du = (got[0] - want[0]).abs();
+                let du = du.min((1.0 - du).abs());
+                assert!(
+                    du < 1e-4 && (got[1] - want[1]).abs() < 1e-4,
+                    "{}: sampled {got:?}, hit {want:?}",
+                    shape.kind_name()
+                );
+            }
+        }
+    }
+}

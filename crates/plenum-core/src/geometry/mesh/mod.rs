@@ -86,6 +86,10 @@ pub struct TriangleMesh {
     normals: Vec<Vec3>,
     /// Per-vertex texture coordinates, or empty.
     uvs: Vec<[f64; 2]>,
+    /// Without per-vertex uvs, the (u, v) of every triangle's corners, in its order.
+    corner_uvs: [[f64; 2]; 3],
+    /// Per-vertex tangents (xyz) and the bitangent's sign (w), as glTF gives them; or empty.
+    tangents: Vec<[f64; 4]>,
     vertex_count: usize,
     triangle_count: usize,
     accel: Accel,
@@ -217,6 +221,8 @@ impl TriangleMesh {
             keeps_indices: keep_indices,
             normals,
             uvs,
+            corner_uvs: BARYCENTRIC_UVS,
+            tangents: Vec::new(),
             vertex_count: positions.len(),
             triangle_count: triangles.len(),
             accel: Accel::default(),
@@ -239,6 +245,55 @@ impl TriangleMesh {
         self.accel.kind()
     }
 
+    /// The mesh with every triangle's corners at (u, v) `corners` where it has no uvs per
+    /// vertex, as some formats say (pbrt-v4: (0, 0), (1, 0), (1, 1)); by default the
+    /// barycentric coordinates, (0, 0), (1, 0), (0, 1).
+    pub fn with_corner_uvs(mut self, corners: [[f64; 2]; 3]) -> TriangleMesh {
+        self.corner_uvs = corners;
+        self
+    }
+
+    /// The mesh with per-vertex `tangents` (xyz, and w the sign of the bitangent
+    /// n × t, glTF's `TANGENT`), which then give normal maps their frame. The mesh must
+    /// keep its vertex indices (it has normals or uvs).
+    pub fn with_tangents(mut self, tangents: Vec<[f64; 4]>) -> Result<TriangleMesh, MeshError> {
+        if tangents.len() != self.vertex_count || !self.keeps_indices {
+            return Err(MeshError::CountMismatch {
+                what: "tangents",
+                found: tangents.len(),
+                vertices: self.vertex_count,
+            });
+        }
+        self.tangents = tangents;
+        Ok(self)
+    }
+
+    /// The tangent and bitangent at a hit, interpolated from the vertices' tangents (the
+    /// bitangent n × t times the sign w, n the shading normal); `None` without tangents.
+    pub fn tangent_frame(&self, hit: &HitRecord) -> Option<[Vec3; 2]> {
+        if self.tangents.is_empty() {
+            return None;
+        }
+        let idx = self.vertex_indices(hit.part)?;
+        let weights = [1.0 - hit.u - hit.v, hit.u, hit.v];
+        let (mut t, mut w) = (Vec3::ZERO, 0.0);
+        for (i, b) in idx.iter().zip(weights) {
+            let [x, y, z, s] = self.tangents[*i as usize];
+            t = t + Vec3::new(x, y, z) * b;
+            w += s * b;
+        }
+        let n = if self.normals.is_empty() {
+            let [p0, p1, p2] = self.triangle(hit.part);
+            (p1 - p0).cross(p2 - p0)
+        } else {
+            idx.iter()
+                .zip(weights)
+                .fold(Vec3::ZERO, |a, (i, b)| a + self.normals[*i as usize] * b)
+        };
+        let sign = if w < 0.0 { -1.0 } else { 1.0 };
+        Some([t, n.normalized().cross(t) * sign])
+    }
+
     /// The mesh with its triangles in a `kind` structure instead.
     pub fn with_accel(&self, kind: AccelKind) -> TriangleMesh {
         self.rebuilt(kind, EMBED_LIMIT)
@@ -253,6 +308,7 @@ impl TriangleMesh {
             indices: Vec::new(),
             normals: self.normals.clone(),
             uvs: self.uvs.clone(),
+            tangents: self.tangents.clone(),
             accel: Accel::default(),
             ..*self
         };
@@ -368,6 +424,7 @@ impl TriangleMesh {
             + self.indices.len() * std::mem::size_of::<[u32; 3]>()
             + self.normals.len() * std::mem::size_of::<Vec3>()
             + self.uvs.len() * std::mem::size_of::<[f64; 2]>()
+            + self.tangents.len() * std::mem::size_of::<[f64; 4]>()
             + self.accel.memory_bytes()
     }
 
@@ -546,7 +603,11 @@ impl TriangleMesh {
             }
         };
         let uv = if self.uvs.is_empty() {
-            [b1, b2]
+            let [t0, t1, t2] = self.corner_uvs;
+            [
+                t0[0] * b0 + t1[0] * b1 + t2[0] * b2,
+                t0[1] * b0 + t1[1] * b1 + t2[1] * b2,
+            ]
         } else {
             let [t0, t1, t2] = idx.map(|i| self.uvs[i as usize]);
             [
@@ -568,11 +629,11 @@ impl TriangleMesh {
     /// and third barycentric coordinates. Zero where the uvs are degenerate.
     pub fn uv_derivatives(&self, hit: &HitRecord) -> [Vec3; 2] {
         let [p0, p1, p2] = self.triangle(hit.part);
-        let idx = match self.vertex_indices(hit.part) {
-            Some(idx) if !self.uvs.is_empty() => idx,
-            _ => return [p1 - p0, p2 - p0],
+        let [t0, t1, t2] = match self.vertex_indices(hit.part) {
+            Some(idx) if !self.uvs.is_empty() => idx.map(|i| self.uvs[i as usize]),
+            _ if self.corner_uvs == BARYCENTRIC_UVS => return [p1 - p0, p2 - p0],
+            _ => self.corner_uvs,
         };
-        let [t0, t1, t2] = idx.map(|i| self.uvs[i as usize]);
         let (duv02, duv12) = (
             [t0[0] - t2[0], t0[1] - t2[1]],
             [t1[0] - t2[0], t1[1] - t2[1]],
@@ -588,6 +649,9 @@ impl TriangleMesh {
         ]
     }
 }
+
+/// The (u, v) of a triangle's corners that the barycentric coordinates (b1, b2) give.
+const BARYCENTRIC_UVS: [[f64; 2]; 3] = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
 
 /// Vertices and vertex indices for triangles given by their corners. With the indices the
 /// mesh was made with, its `vertex_count` vertices (one no triangle uses is left at the
