@@ -350,6 +350,7 @@ impl Emitter {
     }
 
     /// [`Emitter::sample_area`], with where on the emitter the point lies.
+    #[inline]
     fn sample_point(&self, u: [f64; 2]) -> Option<(Vec3, Vec3, EmitterPoint)> {
         let world = |(p, n): (Vec3, Vec3)| (p, n, EmitterPoint::World(p));
         Some(match self {
@@ -405,6 +406,7 @@ impl Emitter {
     /// A point of the surface for `p` to aim at, its unit normal, and the pdf of choosing it
     /// with respect to solid angle at `p` (the area pdf converted by d² / |cos θ_light|);
     /// `None` if the sample sees the surface edge-on. Also where on the emitter the point lies.
+    #[inline]
     fn sample_with_normal(&self, p: Vec3, u: [f64; 2]) -> Option<(Vec3, Vec3, f64, EmitterPoint)> {
         if let Emitter::Sphere { center, radius } = self {
             let to_center = *center - p;
@@ -675,6 +677,7 @@ impl Light {
 
     /// A textured area light's radiance at a point of its surface (linear RGB); `None` where
     /// the light's spectrum is its radiance everywhere.
+    #[inline]
     fn textured_radiance(&self, at: EmitterPoint) -> Option<Color> {
         match self {
             Light::Area {

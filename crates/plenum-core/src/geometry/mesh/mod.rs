@@ -86,8 +86,9 @@ pub struct TriangleMesh {
     normals: Vec<Vec3>,
     /// Per-vertex texture coordinates, or empty.
     uvs: Vec<[f64; 2]>,
-    /// Without per-vertex uvs, the (u, v) of every triangle's corners, in its order.
-    corner_uvs: [[f64; 2]; 3],
+    /// Without per-vertex uvs, the (u, v) of every triangle's corners, in its order; `None`:
+    /// the barycentric coordinates (b1, b2).
+    corner_uvs: Option<[[f64; 2]; 3]>,
     /// Per-vertex tangents (xyz) and the bitangent's sign (w), as glTF gives them; or empty.
     tangents: Vec<[f64; 4]>,
     vertex_count: usize,
@@ -221,7 +222,7 @@ impl TriangleMesh {
             keeps_indices: keep_indices,
             normals,
             uvs,
-            corner_uvs: BARYCENTRIC_UVS,
+            corner_uvs: None,
             tangents: Vec::new(),
             vertex_count: positions.len(),
             triangle_count: triangles.len(),
@@ -249,7 +250,7 @@ impl TriangleMesh {
     /// vertex, as some formats say (pbrt-v4: (0, 0), (1, 0), (1, 1)); by default the
     /// barycentric coordinates, (0, 0), (1, 0), (0, 1).
     pub fn with_corner_uvs(mut self, corners: [[f64; 2]; 3]) -> TriangleMesh {
-        self.corner_uvs = corners;
+        self.corner_uvs = Some(corners);
         self
     }
 
@@ -603,11 +604,13 @@ impl TriangleMesh {
             }
         };
         let uv = if self.uvs.is_empty() {
-            let [t0, t1, t2] = self.corner_uvs;
-            [
-                t0[0] * b0 + t1[0] * b1 + t2[0] * b2,
-                t0[1] * b0 + t1[1] * b1 + t2[1] * b2,
-            ]
+            match self.corner_uvs {
+                None => [b1, b2],
+                Some([t0, t1, t2]) => [
+                    t0[0] * b0 + t1[0] * b1 + t2[0] * b2,
+                    t0[1] * b0 + t1[1] * b1 + t2[1] * b2,
+                ],
+            }
         } else {
             let [t0, t1, t2] = idx.map(|i| self.uvs[i as usize]);
             [
@@ -631,8 +634,10 @@ impl TriangleMesh {
         let [p0, p1, p2] = self.triangle(hit.part);
         let [t0, t1, t2] = match self.vertex_indices(hit.part) {
             Some(idx) if !self.uvs.is_empty() => idx.map(|i| self.uvs[i as usize]),
-            _ if self.corner_uvs == BARYCENTRIC_UVS => return [p1 - p0, p2 - p0],
-            _ => self.corner_uvs,
+            _ => match self.corner_uvs {
+                None => return [p1 - p0, p2 - p0],
+                Some(corners) => corners,
+            },
         };
         let (duv02, duv12) = (
             [t0[0] - t2[0], t0[1] - t2[1]],
@@ -649,9 +654,6 @@ impl TriangleMesh {
         ]
     }
 }
-
-/// The (u, v) of a triangle's corners that the barycentric coordinates (b1, b2) give.
-const BARYCENTRIC_UVS: [[f64; 2]; 3] = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
 
 /// Vertices and vertex indices for triangles given by their corners. With the indices the
 /// mesh was made with, its `vertex_count` vertices (one no triangle uses is left at the
