@@ -44,6 +44,7 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<(SceneBuilder, RenderDefaults,
         camera: None,
         bounds: Bounds3::default(),
         lights: 0,
+        uv_set: 0,
     };
     r.buffers = r.load_buffers(gltf.blob.as_deref(), base)?;
     if gltf.document.animations().next().is_some() {
@@ -154,6 +155,37 @@ struct Reader<'a> {
     camera: Option<(gltf::Camera<'a>, Matrix4)>,
     bounds: Bounds3,
     lights: usize,
+    /// The texture coordinate set of the material being read ([`uv_set`]).
+    uv_set: u32,
+}
+
+/// The texture coordinate set a texture reference reads (`KHR_texture_transform` may
+/// override it).
+fn info_set(info: &gltf::texture::Info<'_>) -> u32 {
+    info.texture_transform()
+        .and_then(|t| t.tex_coord())
+        .unwrap_or(info.tex_coord())
+}
+
+/// [`info_set`] of a normal texture, whose transform the `gltf` crate leaves in its JSON.
+fn normal_set(n: &gltf::material::NormalTexture<'_>) -> u32 {
+    n.extension_value("KHR_texture_transform")
+        .and_then(|t| t.get("texCoord"))
+        .and_then(|v| v.as_u64())
+        .map_or(n.tex_coord(), |v| v as u32)
+}
+
+/// The texture coordinate set a material's meshes carry (Plenum's meshes have one): that of
+/// its first texture among base colour, metallic–roughness, normal and emissive; 0 without
+/// textures. Its textures reading another set are warned about.
+fn uv_set(m: &gltf::Material<'_>) -> u32 {
+    let pbr = m.pbr_metallic_roughness();
+    pbr.base_color_texture()
+        .map(|i| info_set(&i))
+        .or_else(|| pbr.metallic_roughness_texture().map(|i| info_set(&i)))
+        .or_else(|| m.normal_texture().map(|n| normal_set(&n)))
+        .or_else(|| m.emissive_texture().map(|i| info_set(&i)))
+        .unwrap_or(0)
 }
 
 /// A texture's image decoded, where it came from, and the uv transform its textureInfo gives.
@@ -385,10 +417,12 @@ impl<'a> Reader<'a> {
                 .collect(),
             None => Vec::new(),
         };
-        // glTF's uv origin is the image's top-left, Plenum's its bottom-left.
-        let uvs: Vec<[f64; 2]> = match p.get(&gltf::Semantic::TexCoords(0)) {
+        // glTF's uv origin is the image's top-left, Plenum's its bottom-left. A mesh
+        // carries one set of uvs: the one its material's textures read.
+        let set = uv_set(&p.material());
+        let uvs: Vec<[f64; 2]> = match p.get(&gltf::Semantic::TexCoords(set)) {
             Some(t) => self
-                .floats::<2>(&t, "TEXCOORD_0")?
+                .floats::<2>(&t, &format!("TEXCOORD_{set}"))?
                 .into_iter()
                 .map(|[u, v]| [u, 1.0 - v])
                 .collect(),
@@ -441,12 +475,10 @@ impl<'a> Reader<'a> {
         base: &Path,
         at: &str,
     ) -> Result<Decoded> {
-        let transform = info.texture_transform();
-        let set = transform
-            .as_ref()
-            .and_then(|t| t.tex_coord())
-            .unwrap_or(info.tex_coord());
-        let uv_map = transform.map(|t| (t.offset(), t.rotation(), t.scale()));
+        let set = info_set(info);
+        let uv_map = info
+            .texture_transform()
+            .map(|t| (t.offset(), t.rotation(), t.scale()));
         self.texels_of(info.texture(), set, uv_map, colour, base, at)
     }
 
@@ -466,10 +498,7 @@ impl<'a> Reader<'a> {
             Some(a) if a.len() == 2 => [0, 1].map(|i| a[i].as_f64().unwrap_or(0.0) as f32),
             _ => default,
         };
-        let set = t
-            .and_then(|t| t.get("texCoord"))
-            .and_then(|v| v.as_u64())
-            .map_or(n.tex_coord(), |v| v as u32);
+        let set = normal_set(n);
         let rotation = t.and_then(|t| t.get("rotation")).and_then(|v| v.as_f64());
         let uv_map = t.map(|_| {
             let r = rotation.unwrap_or(0.0) as f32;
@@ -489,9 +518,10 @@ impl<'a> Reader<'a> {
         base: &Path,
         at: &str,
     ) -> Result<Decoded> {
-        if set != 0 {
+        if set != self.uv_set {
+            let used = self.uv_set;
             self.warn(format!(
-                "{at}: texture coordinates {set} are not supported: using TEXCOORD_0"
+                "{at}: texture coordinates {set} differ from those of the material's first texture, and a mesh carries one set: using TEXCOORD_{used}"
             ));
         }
         let uv_transform = uv_map.map(|([ox, oy], r, [sx, sy])| {
@@ -595,6 +625,7 @@ impl<'a> Reader<'a> {
             None => "the default material".to_string(),
         };
         let name = m.name().map(str::to_string).unwrap_or_else(|| at.clone());
+        self.uv_set = uv_set(m);
         let pbr = m.pbr_metallic_roughness();
         let [r, g, b, _] = pbr.base_color_factor().map(|x| x as f64);
         let base_texels = match pbr.base_color_texture() {
@@ -673,13 +704,32 @@ impl<'a> Reader<'a> {
             }
             None => None,
         };
+        // KHR_materials_specular scales the dielectric's reflectance at normal incidence,
+        // F0 = ((ior − 1)/(ior + 1))², by the colour factor and the specular factor: the
+        // coat gets the ior whose F0 that is (Fresnel's rise toward grazing kept).
+        let coat_eta = match m.specular() {
+            Some(s) if s.specular_factor() != 1.0 || s.specular_color_factor() != [1.0; 3] => {
+                let c = s.specular_color_factor().map(|x| x as f64);
+                let colour = (c[0] + c[1] + c[2]) / 3.0;
+                if c[0] != c[1] || c[1] != c[2] {
+                    self.warn(format!("{at}: a coloured specularColorFactor is not supported: its mean, {colour}, scales the reflectance"));
+                }
+                if transmission > 0.0 {
+                    self.warn(format!(
+                        "{at}: KHR_materials_specular on transmission: the glass keeps its ior"
+                    ));
+                }
+                let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
+                let f0 = (f0 * colour).min(1.0) * (s.specular_factor() as f64).clamp(0.0, 1.0);
+                let root = f0.sqrt().min(0.999);
+                let coat_ior = (1.0 + root) / (1.0 - root);
+                SpectrumValue::new(Spectrum::Constant(coat_ior), SpectrumKind::Unbounded)
+            }
+            _ => eta.clone(),
+        };
         if let Some(s) = m.specular() {
-            if s.specular_factor() != 1.0
-                || s.specular_color_factor() != [1.0; 3]
-                || s.specular_texture().is_some()
-                || s.specular_color_texture().is_some()
-            {
-                self.warn(format!("{at}: KHR_materials_specular is not supported: the coat reflects as its ior says"));
+            if s.specular_texture().is_some() || s.specular_color_texture().is_some() {
+                self.warn(format!("{at}: specularTexture and specularColorTexture are not supported: their factors are used"));
             }
         }
         if m.volume().is_some() {
@@ -706,7 +756,7 @@ impl<'a> Reader<'a> {
             reflectance: base_color.clone(),
             roughness: roughness.clone(),
             thickness: 0.01,
-            eta: eta.clone(),
+            eta: coat_eta,
             albedo: SpectralTexture::constant(Color::BLACK, SpectrumKind::Albedo),
             g: 0.0,
             max_depth: 10,

@@ -22,7 +22,8 @@ use plenum_core::material::{
 use plenum_core::math::{Matrix4, Transform, Vec3};
 use plenum_core::sampling::{FilterKind, Frame, SamplerKind};
 use plenum_core::scene::{Alpha, Bitangent, Bump, MaterialId, SceneBuilder};
-use plenum_core::texture::{ImageTexture, Texture, Wrap};
+use plenum_core::texture::noise::MAX_OCTAVES;
+use plenum_core::texture::{ImageTexture, Mapping, Noise, Texture, Wrap};
 use plenum_spectrum::Spectrum;
 use std::cell::Cell;
 use std::collections::HashMap;
@@ -506,7 +507,6 @@ fn takes_one_string(d: &str) -> bool {
             | "MakeNamedMedium"
             | "ColorSpace"
             | "Attribute"
-            | "Option"
     )
 }
 
@@ -553,6 +553,21 @@ fn column_major(n: &[f64]) -> Matrix4 {
     }
     m
 }
+
+/// The names pbrt-v4's `Option` knows.
+const PBRT_OPTIONS: [&str; 11] = [
+    "disablepixeljitter",
+    "disabletexturefiltering",
+    "disablewavelengthjitter",
+    "displacementedgescale",
+    "forcediffuse",
+    "msereferenceimage",
+    "msereferenceout",
+    "pixelstats",
+    "rendercoordsys",
+    "seed",
+    "wavefront",
+];
 
 /// The (u, v) pbrt-v4 gives the corners of a triangle without uv.
 const PBRT_TRIANGLE_UVS: [[f64; 2]; 3] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]];
@@ -854,6 +869,103 @@ impl Parser {
 
     // ---- Statements ----
 
+    /// pbrt-v4's `Option "name" value`: a rendering option given in the scene (a type
+    /// before the name, as in `"bool disablepixeljitter"`, is read past).
+    fn option(&mut self, args: &[(Tok, Loc)], loc: &Loc) -> Result<()> {
+        let mut rest = args
+            .iter()
+            .filter(|(t, _)| !matches!(t, Tok::Open | Tok::Close));
+        let Some((Tok::Str(given), name_loc)) = rest.next() else {
+            return Err(self.error(
+                loc,
+                "Option needs a quoted name and a value, as in Option \"seed\" 7",
+            ));
+        };
+        let Some((value, value_loc)) = rest.next() else {
+            return Err(self.error(name_loc, format!("Option \"{given}\" needs a value")));
+        };
+        if let Some((_, extra)) = rest.next() {
+            return Err(self.error(extra, "Option takes one value"));
+        }
+        // pbrt-v4 ignores case, `_` and `-` in option names.
+        let name: String = given
+            .rsplit(' ')
+            .next()
+            .unwrap_or_default()
+            .chars()
+            .filter(|c| *c != '_' && *c != '-')
+            .flat_map(char::to_lowercase)
+            .collect();
+        let kind = match name.as_str() {
+            "disablepixeljitter"
+            | "disabletexturefiltering"
+            | "disablewavelengthjitter"
+            | "forcediffuse"
+            | "pixelstats"
+            | "wavefront" => "bool",
+            "seed" => "integer",
+            "displacementedgescale" => "float",
+            "msereferenceimage" | "msereferenceout" | "rendercoordsys" => "string",
+            _ => {
+                return Err(self.unknown(name_loc, "option", given, &PBRT_OPTIONS));
+            }
+        };
+        let fits = match (kind, value) {
+            ("bool", Tok::Word(_)) => true,
+            ("integer", Tok::Num(x)) => x.fract() == 0.0,
+            ("float", Tok::Num(_)) => true,
+            ("string", Tok::Str(_)) => true,
+            _ => false,
+        };
+        if !fits {
+            let expected = match kind {
+                "bool" => "true or false",
+                "integer" => "a whole number",
+                "float" => "a number",
+                _ => "a quoted string",
+            };
+            return Err(self.error(
+                value_loc,
+                format!("expected {expected} for Option \"{given}\""),
+            ));
+        }
+        let on = matches!(value, Tok::Word(w) if w == "true");
+        let ignored = |what: &str| format!("Option \"{given}\" ({what}) is not supported: ignored");
+        match name.as_str() {
+            // What pbrt-v4 computes in, how it runs, or its seed: the same image.
+            "seed" | "wavefront" => {}
+            "rendercoordsys" => {
+                let Tok::Str(space) = value else {
+                    unreachable!()
+                };
+                if !matches!(space.as_str(), "camera" | "cameraworld" | "world") {
+                    return Err(self.error(
+                        value_loc,
+                        format!("unknown rendering space `{space}`: expected camera, cameraworld or world"),
+                    ));
+                }
+            }
+            // Options switched off change nothing.
+            "disablepixeljitter"
+            | "disabletexturefiltering"
+            | "disablewavelengthjitter"
+            | "forcediffuse"
+            | "pixelstats"
+                if !on => {}
+            "disablepixeljitter" => self.warn(loc, ignored("samples at pixel centres")),
+            "disabletexturefiltering" => self.warn(
+                loc,
+                ignored("point-sampled textures; Plenum's images are interpolated bilinearly"),
+            ),
+            "disablewavelengthjitter" => self.warn(loc, ignored("fixed wavelengths")),
+            "forcediffuse" => self.warn(loc, ignored("every material made diffuse")),
+            "pixelstats" => self.warn(loc, ignored("per-pixel statistics images")),
+            "displacementedgescale" => self.warn(loc, ignored("displacement tessellation")),
+            _ => self.warn(loc, ignored("an error image against a reference")),
+        }
+        Ok(())
+    }
+
     fn statement(&mut self, d: &str, loc: &Loc, args: &[(Tok, Loc)], params: Params) -> Result<()> {
         // `Attribute` defaults come first: the statement's own parameters, found later, win.
         let kind = match d {
@@ -1061,7 +1173,8 @@ impl Parser {
                     });
                 }
             }
-            "Option" | "MakeNamedMedium" | "MediumInterface" => {
+            "Option" => self.option(args, loc)?,
+            "MakeNamedMedium" | "MediumInterface" => {
                 self.warn(loc, format!("{d} is not supported: ignored"));
                 params.list.iter().for_each(|p| p.used.set(true));
             }
@@ -1740,19 +1853,104 @@ impl Parser {
                 }
             }
         };
-        let mapping = |s: &mut Self| -> Result<[f64; 2]> {
-            if let Some((m, l)) = s.string(p, "mapping")? {
-                if m != "uv" {
-                    s.warn(&l, format!("the `{m}` mapping is not supported: using uv"));
+        // The texture's space: the transformation current where it is defined.
+        let to_texture = Transform::from_matrix(self.ctm())
+            .ok_or_else(|| self.error(loc, "the texture's transformation is singular"))?
+            .inverted();
+        let mapping = |s: &mut Self| -> Result<Mapping> {
+            let uv = |s: &mut Self| -> Result<Mapping> {
+                Ok(Mapping::Uv {
+                    scale: [s.float(p, "uscale", 1.0)?, s.float(p, "vscale", 1.0)?],
+                    delta: [s.float(p, "udelta", 0.0)?, s.float(p, "vdelta", 0.0)?],
+                })
+            };
+            Ok(match s.string(p, "mapping")? {
+                None | Some(("uv", _)) => uv(s)?,
+                Some(("spherical", _)) => Mapping::Spherical(to_texture.clone()),
+                Some(("cylindrical", _)) => Mapping::Cylindrical(to_texture.clone()),
+                Some(("planar", _)) => Mapping::Planar {
+                    to_texture: to_texture.clone(),
+                    axes: [s.point(p, "v1", Vec3::X)?, s.point(p, "v2", Vec3::Y)?],
+                    delta: [s.float(p, "udelta", 0.0)?, s.float(p, "vdelta", 0.0)?],
+                },
+                Some((m, l)) => {
+                    s.warn(
+                        &l,
+                        format!("unknown mapping `{m}` (expected uv, spherical, cylindrical or planar): using uv"),
+                    );
+                    uv(s)?
                 }
+            })
+        };
+        // A texture under a mapping: the identity (u, v) mapping is no mapping, and a scale
+        // of (u, v) alone is kept by the checker and bilerp textures themselves.
+        let mapped = |m: Mapping, t: Texture| match (m, t) {
+            (
+                Mapping::Uv {
+                    scale: [1.0, 1.0],
+                    delta: [0.0, 0.0],
+                },
+                t,
+            ) => t,
+            (
+                Mapping::Uv {
+                    scale: [su, sv],
+                    delta: [0.0, 0.0],
+                },
+                Texture::Checker2d {
+                    even,
+                    odd,
+                    scale: 1.0,
+                },
+            ) if su == sv && su > 0.0 => Texture::Checker2d {
+                even,
+                odd,
+                scale: su,
+            },
+            (
+                Mapping::Uv {
+                    scale,
+                    delta: [0.0, 0.0],
+                },
+                Texture::Bilerp(b),
+            ) if b.1 == [1.0, 1.0] => Texture::Bilerp(Arc::new((b.0, scale))),
+            (m, t) => Texture::Mapped(Arc::new((m, t))),
+        };
+        // A texture operand: a texture by name, or a value (a constant texture).
+        let operand = |s: &Self, key: &str, default: f64| -> Result<Texture> {
+            match p.get(key) {
+                Some(q) if q.ty == "texture" => s.texture_ref(q),
+                _ => Ok(Texture::Constant(
+                    constant(s, key, default)?.unwrap_or(Color::gray(default)),
+                )),
             }
-            for key in ["udelta", "vdelta"] {
-                if s.float(p, key, 0.0)? != 0.0 {
-                    let l = p.get(key).unwrap().loc.clone();
-                    s.warn(&l, format!("`{key}` is not supported: no offset"));
-                }
+        };
+        // `a` where the pattern is 0, `b` where it is 1.
+        let between = |a: Texture, b: Texture, pattern: Texture| {
+            let t = Texture::Mix(Arc::new([a, b, pattern]));
+            t.constant_value().map_or(t, Texture::Constant)
+        };
+        let octaves = |s: &mut Self| -> Result<u32> {
+            let n = s.integer(p, "octaves", 8)?;
+            if n < 0 {
+                return Err(s.error(
+                    &p.get("octaves").unwrap().loc,
+                    format!("expected `octaves` ≥ 0, found {n}"),
+                ));
             }
-            Ok([s.positive(p, "uscale", 1.0)?, s.positive(p, "vscale", 1.0)?])
+            if n > MAX_OCTAVES as i64 {
+                s.warn(
+                    &p.get("octaves").unwrap().loc,
+                    format!("{n} octaves: the finest beyond {MAX_OCTAVES} are below f64's precision and are left out"),
+                );
+            }
+            Ok((n as u32).min(MAX_OCTAVES))
+        };
+        let solid = |t: Noise| {
+            Texture::Mapped(Arc::new((
+                Mapping::Solid(to_texture.clone()),
+                Texture::Noise(Arc::new(t)),
+            )))
         };
         Ok(match ty {
             "constant" => Texture::Constant(constant(self, "value", 1.0)?.unwrap_or(Color::WHITE)),
@@ -1761,7 +1959,14 @@ impl Parser {
                     return Err(self.error(loc, "an imagemap needs a \"string filename\""));
                 };
                 let path = self.path_in(floc.file, file);
-                let scale_uv = mapping(self)?;
+                // A positive scale of (u, v) is the image's own repeat count.
+                let (repeats, map) = match mapping(self)? {
+                    Mapping::Uv {
+                        scale,
+                        delta: [0.0, 0.0],
+                    } if scale[0] > 0.0 && scale[1] > 0.0 => (scale, None),
+                    m => ([1.0, 1.0], Some(m)),
+                };
                 let scale = self.float(p, "scale", 1.0)?;
                 let invert = self.boolean_param(p, "invert", false)?;
                 p.get("filter");
@@ -1805,55 +2010,89 @@ impl Parser {
                     }
                 };
                 let fallback = "a neutral grey (0.5) instead";
-                match self.image(&path, &floc, fallback, linear, texel, scale_uv, wrap)? {
-                    Some(image) => image,
+                match self.image(&path, &floc, fallback, linear, texel, repeats, wrap)? {
+                    Some(image) => match map {
+                        None => image,
+                        Some(m) => mapped(m, image),
+                    },
                     None => Texture::Constant(Color::gray(0.5)),
                 }
             }
             "checkerboard" => {
-                let dimension = self.integer(p, "dimension", 2)?;
-                let scale = mapping(self)?;
-                let even = constant(self, "tex1", 1.0)?;
-                let odd = constant(self, "tex2", 0.0)?;
-                let (Some(even), Some(odd)) = (even, odd) else {
-                    self.warn(
-                        loc,
-                        "a checkerboard of textures is not supported: using their mean colours",
-                    );
-                    return Ok(Texture::Constant(Color::gray(0.5)));
+                let (a, b) = (operand(self, "tex1", 1.0)?, operand(self, "tex2", 0.0)?);
+                // Two colours make the checker itself; textures are mixed by its pattern,
+                // 0 on tex1's squares and 1 on tex2's.
+                let (even, odd, textures) = match (a.constant_value(), b.constant_value()) {
+                    (Some(a), Some(b)) => (a, b, None),
+                    _ => (Color::BLACK, Color::WHITE, Some((a, b))),
                 };
-                if scale[0] != scale[1] {
-                    self.warn(
-                        loc,
-                        "a checkerboard scaled differently in u and v: using uscale",
-                    );
-                }
-                match dimension {
-                    2 => Texture::Checker2d {
-                        even,
-                        odd,
-                        scale: scale[0],
-                    },
-                    3 => Texture::Checker3d {
-                        even,
-                        odd,
-                        scale: 1.0,
-                    },
+                let pick = |pattern: Texture| match textures {
+                    None => pattern,
+                    Some((a, b)) => between(a, b, pattern),
+                };
+                match self.integer(p, "dimension", 2)? {
+                    2 => {
+                        let squares = Texture::Checker2d {
+                            even,
+                            odd,
+                            scale: 1.0,
+                        };
+                        pick(mapped(mapping(self)?, squares))
+                    }
+                    3 => {
+                        let cubes = Texture::Checker3d {
+                            even,
+                            odd,
+                            scale: 1.0,
+                        };
+                        let space = Mapping::Solid(to_texture.clone());
+                        pick(Texture::Mapped(Arc::new((space, cubes))))
+                    }
                     d => {
                         return Err(self.error(loc, format!("expected dimension 2 or 3, found {d}")))
                     }
                 }
             }
+            "dots" => {
+                let inside = operand(self, "inside", 1.0)?;
+                let outside = operand(self, "outside", 0.0)?;
+                // pbrt-v4 hands `inside` and `outside` to its dots texture in the other
+                // order than that texture takes them: its dots show `outside`, and the
+                // plane between them `inside`. Plenum renders what pbrt-v4 renders.
+                between(inside, outside, mapped(mapping(self)?, Texture::Dots))
+            }
+            "fbm" | "wrinkled" => {
+                let omega = self.float(p, "roughness", 0.5)?;
+                let octaves = octaves(self)?;
+                solid(match ty {
+                    "fbm" => Noise::Fbm { omega, octaves },
+                    _ => Noise::Wrinkled { omega, octaves },
+                })
+            }
+            "windy" => solid(Noise::Windy),
+            "marble" => {
+                let octaves = octaves(self)?;
+                solid(Noise::Marble {
+                    omega: self.float(p, "roughness", 0.5)?,
+                    octaves,
+                    scale: self.float(p, "scale", 1.0)?,
+                    variation: self.float(p, "variation", 0.2)?,
+                })
+            }
+            "directionmix" => {
+                let d = Transform::from_matrix(self.ctm())
+                    .expect("inverted above")
+                    .vector(self.point(p, "dir", Vec3::Y)?);
+                if !(d.length() > 0.0) || !finite(d) {
+                    return Err(self.error(
+                        &p.get("dir").map_or(loc.clone(), |q| q.loc.clone()),
+                        "expected a non-zero `dir`",
+                    ));
+                }
+                let (a, b) = (operand(self, "tex1", 0.0)?, operand(self, "tex2", 1.0)?);
+                Texture::DirectionMix(Arc::new((d.normalized(), [a, b])))
+            }
             "scale" | "mix" => {
-                // An operand: a texture by name, or a value (a constant texture).
-                let operand = |s: &Self, key: &str, default: f64| -> Result<Texture> {
-                    match p.get(key) {
-                        Some(q) if q.ty == "texture" => s.texture_ref(q),
-                        _ => Ok(Texture::Constant(
-                            constant(s, key, default)?.unwrap_or(Color::gray(default)),
-                        )),
-                    }
-                };
                 let (a, b, amount) = match ty {
                     "scale" => (
                         operand(self, "tex", 1.0)?,
@@ -1876,7 +2115,7 @@ impl Parser {
                     .map_or(combined, Texture::Constant)
             }
             "bilerp" => {
-                let scale = mapping(self)?;
+                let map = mapping(self)?;
                 let corner = |s: &Self, key: &str, default: f64| -> Result<Color> {
                     constant(s, key, default)?.ok_or_else(|| {
                         s.error(
@@ -1891,7 +2130,7 @@ impl Parser {
                     corner(self, "v01", 1.0)?,
                     corner(self, "v11", 1.0)?,
                 ];
-                Texture::Bilerp(Arc::new((corners, scale)))
+                mapped(map, Texture::Bilerp(Arc::new((corners, [1.0, 1.0]))))
             }
             other => {
                 self.warn(

@@ -10,7 +10,7 @@ use plenum_core::light::{Attenuation, Emitter, Light};
 use plenum_core::material::{ConductorSpec, FloatTexture, Material, Roughness, SpectralTexture};
 use plenum_core::math::{Transform, Vec3};
 use plenum_core::scene::Scene;
-use plenum_core::texture::Texture;
+use plenum_core::texture::{Mapping, Noise, Texture};
 use plenum_spectrum::Spectrum;
 use std::collections::HashMap;
 use std::fmt::Write;
@@ -710,6 +710,58 @@ fn inline_texture(t: &Texture) -> String {
             inline_texture(&t[1]),
             inline_texture(&t[2])
         ),
+        Texture::DirectionMix(m) => format!(
+            "{{ texture = \"directionmix\", textures = [{}, {}], direction = {} }}",
+            inline_texture(&m.1[0]),
+            inline_texture(&m.1[1]),
+            vec(m.0)
+        ),
+        Texture::Noise(n) => match **n {
+            Noise::Fbm { omega, octaves } => {
+                format!("{{ texture = \"fbm\", omega = {omega:?}, octaves = {octaves} }}")
+            }
+            Noise::Wrinkled { omega, octaves } => {
+                format!("{{ texture = \"wrinkled\", omega = {omega:?}, octaves = {octaves} }}")
+            }
+            Noise::Windy => "{ texture = \"windy\" }".to_string(),
+            Noise::Marble {
+                omega,
+                octaves,
+                scale,
+                variation,
+            } => format!(
+                "{{ texture = \"marble\", omega = {omega:?}, octaves = {octaves}, scale = {scale:?}, variation = {variation:?} }}"
+            ),
+        },
+        Texture::Dots => "{ texture = \"dots\" }".to_string(),
+        Texture::Mapped(m) => {
+            let of = inline_texture(&m.1);
+            let placed = |to_texture: &Transform| {
+                format!("transform = {{ matrix = {} }}", matrix(&to_texture.inverted()))
+            };
+            let pair = |p: [f64; 2]| format!("[{:?}, {:?}]", p[0], p[1]);
+            let mapping = match &m.0 {
+                Mapping::Uv { scale, delta } => format!(
+                    "mapping = \"uv\", scale = {}, delta = {}",
+                    pair(*scale),
+                    pair(*delta)
+                ),
+                Mapping::Spherical(t) => format!("mapping = \"spherical\", {}", placed(t)),
+                Mapping::Cylindrical(t) => format!("mapping = \"cylindrical\", {}", placed(t)),
+                Mapping::Solid(t) => format!("mapping = \"solid\", {}", placed(t)),
+                Mapping::Planar {
+                    to_texture,
+                    axes,
+                    delta,
+                } => format!(
+                    "mapping = \"planar\", {}, axes = {}, delta = {}",
+                    placed(to_texture),
+                    points(axes),
+                    pair(*delta)
+                ),
+            };
+            format!("{{ texture = \"mapped\", {mapping}, of = {of} }}")
+        }
     }
 }
 

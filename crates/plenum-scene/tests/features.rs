@@ -557,10 +557,7 @@ material = "m"
             panic!("expected a Phong material");
         };
         for (u, want) in [-0.25, 1.25].into_iter().zip(want) {
-            let at = TextureCoords {
-                uv: [u, 1.5],
-                object_point: Vec3::ZERO,
-            };
+            let at = TextureCoords::new([u, 1.5], Vec3::ZERO);
             let got = p.diffuse.evaluate(&at).g;
             assert!((got - want).abs() < 0.01, "{wrap} at u = {u}: {got}");
         }

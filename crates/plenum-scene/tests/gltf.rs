@@ -457,10 +457,7 @@ fn the_metallic_roughness_texture_varies_both() {
         panic!("expected the metal second");
     };
     // Plenum's (u, v) has v up: the image's top-left texel is at (0.25, 0.75).
-    let at = |u: f64, v: f64| TextureCoords {
-        uv: [u, v],
-        object_point: Vec3::ZERO,
-    };
+    let at = |u: f64, v: f64| TextureCoords::new([u, v], Vec3::ZERO);
     for ((u, v), rough, metallic) in [
         ((0.25, 0.75), 1.0, 0.0),
         ((0.75, 0.75), 0.0, 1.0),
@@ -512,10 +509,7 @@ fn texture_transforms_map_the_uvs_as_the_extensions_examples_say() {
     use plenum_core::math::Vec3;
     use plenum_core::texture::TextureCoords;
     // Plenum's (u, v), v up: (0.3, 0.7) is glTF's (0.3, 0.3), in the top-left quadrant.
-    let at = |u: f64, v: f64| TextureCoords {
-        uv: [u, v],
-        object_point: Vec3::ZERO,
-    };
+    let at = |u: f64, v: f64| TextureCoords::new([u, v], Vec3::ZERO);
     let rgb = |t: &plenum_core::material::SpectralTexture, u, v| {
         let c = t.rgb(&at(u, v));
         [c.r, c.g, c.b].map(|x| (x * 100.0).round() / 100.0)
@@ -686,4 +680,149 @@ fn tangent_attributes_give_the_normal_map_its_frame() {
             "tangent {tangent:?}, texel {texel:?}: {got:?} vs {want:?}"
         );
     }
+}
+
+#[test]
+fn khr_materials_specular_scales_the_coats_reflectance() {
+    // F0 = ((ior − 1)/(ior + 1))² = 0.04 at ior 1.5; the coat gets the ior whose F0 is
+    // that times the colour factor's mean times the specular factor.
+    let coat_eta = |specular: &str| {
+        let m = format!(
+            r#"{{"pbrMetallicRoughness": {{"metallicFactor": 0}}, "extensions": {{"KHR_materials_specular": {specular}}}}}"#
+        );
+        let l = load(&document(&data_uri(), "0", r#"{"mesh": 0}"#, &m, ""));
+        let t = native(&l);
+        let name = t["objects"][0]["material"].as_str().unwrap().to_string();
+        let m = t["materials"][&name].as_table().unwrap().clone();
+        assert_eq!(m["type"].as_str(), Some("coateddiffuse"));
+        // Only the material's warnings (not those of the missing camera and lights).
+        let warnings: Vec<String> = l
+            .warnings
+            .into_iter()
+            .filter(|w| w.contains("materials["))
+            .collect();
+        (number(&m["eta"]), warnings)
+    };
+    let ior_of = |f0: f64| (1.0 + f0.sqrt()) / (1.0 - f0.sqrt());
+    let (eta, warnings) = coat_eta(r#"{"specularFactor": 0.5}"#);
+    assert!((eta - ior_of(0.02)).abs() < 1e-6, "{eta}");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    // No specular reflection at all: a coat that does not reflect.
+    let (eta, _) = coat_eta(r#"{"specularFactor": 0}"#);
+    assert!((eta - 1.0).abs() < 1e-12, "{eta}");
+    // A grey colour factor scales F0 too; a coloured one by its mean, with a warning.
+    let (eta, warnings) = coat_eta(r#"{"specularColorFactor": [0.25, 0.25, 0.25]}"#);
+    assert!(
+        (eta - ior_of(0.01)).abs() < 1e-6 && warnings.is_empty(),
+        "{eta}"
+    );
+    let (eta, warnings) = coat_eta(r#"{"specularColorFactor": [1, 0.5, 0]}"#);
+    assert!((eta - ior_of(0.02)).abs() < 1e-6, "{eta}");
+    assert!(
+        warnings.len() == 1
+            && warnings[0].contains("materials[0]")
+            && warnings[0].contains("coloured"),
+        "{warnings:?}"
+    );
+    // The defaults change nothing.
+    let (eta, warnings) = coat_eta("{}");
+    assert!((eta - 1.5).abs() < 1e-12 && warnings.is_empty());
+}
+
+#[test]
+fn textures_read_the_texture_coordinate_set_they_name() {
+    // The square with two uv sets: TEXCOORD_0 all (0, 0), TEXCOORD_1 the square's own
+    // ((x + ½, ½ − y) in glTF's v-down uv). The material's textures read set 1, so the
+    // mesh carries set 1; an emissive texture reading set 0 is warned about.
+    use plenum_core::math::{Ray, Vec3};
+    let corners = [[-0.5f32, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]];
+    let mut buffer = Vec::new();
+    for [x, y] in corners {
+        for c in [x, y, 0.0] {
+            buffer.extend(c.to_le_bytes());
+        }
+    }
+    for _ in corners {
+        buffer.extend([0u8; 8]);
+    }
+    for [x, y] in corners {
+        for c in [x + 0.5, 0.5 - y] {
+            buffer.extend(c.to_le_bytes());
+        }
+    }
+    for i in [0u16, 1, 2, 0, 2, 3] {
+        buffer.extend(i.to_le_bytes());
+    }
+    let image = base64(&png(1, 1, 3, &[200, 100, 50]));
+    let doc = |material: &str| {
+        format!(
+            r#"{{
+  "asset": {{"version": "2.0"}},
+  "scene": 0,
+  "scenes": [{{"nodes": [0]}}],
+  "nodes": [{{"mesh": 0}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2}}, "indices": 3, "material": 0}}]}}],
+  "materials": [{material}],
+  "images": [{{"uri": "data:image/png;base64,{image}"}}],
+  "textures": [{{"source": 0}}],
+  "buffers": [{{"byteLength": 124, "uri": "data:application/octet-stream;base64,{}"}}],
+  "bufferViews": [{{"buffer": 0, "byteOffset": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": 32}}, {{"buffer": 0, "byteOffset": 80, "byteLength": 32}}, {{"buffer": 0, "byteOffset": 112, "byteLength": 12}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-0.5, -0.5, 0], "max": [0.5, 0.5, 0]}},
+    {{"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"}},
+    {{"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"}},
+    {{"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}}
+  ]
+}}"#,
+            base64(&buffer)
+        )
+    };
+    let uv_at = |l: &LoadedScene, x: f64, y: f64| {
+        let ray = Ray::new(Vec3::new(x, y, 3.0), -Vec3::Z);
+        let (prim, hit) = l.scene.geometry.intersect(&ray, f64::INFINITY).unwrap();
+        l.scene.geometry.interaction(&ray, prim, &hit).uv
+    };
+    let near = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-6;
+    // Set 1, named by the textureInfo or by KHR_texture_transform's texCoord.
+    for base in [
+        r#"{"index": 0, "texCoord": 1}"#,
+        r#"{"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": 1}}}"#,
+    ] {
+        let l = load(&doc(&format!(
+            r#"{{"pbrMetallicRoughness": {{"baseColorTexture": {base}}}}}"#
+        )));
+        assert!(
+            !l.warnings.iter().any(|w| w.contains("materials[")),
+            "{:?}",
+            l.warnings
+        );
+        // Plenum's v is up: (x + ½, y + ½).
+        assert!(
+            near(uv_at(&l, 0.2, -0.1), [0.7, 0.4]),
+            "{:?}",
+            uv_at(&l, 0.2, -0.1)
+        );
+    }
+    // Without texCoord, set 0.
+    let l = load(&doc(
+        r#"{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}"#,
+    ));
+    assert!(near(uv_at(&l, 0.2, -0.1), [0.0, 1.0]));
+    // Two sets in one material: the first texture's, and a located warning for the other.
+    let l = load(&doc(
+        r#"{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}}, "emissiveFactor": [1, 1, 1], "emissiveTexture": {"index": 0}}"#,
+    ));
+    assert!(near(uv_at(&l, 0.2, -0.1), [0.7, 0.4]));
+    let about: Vec<&String> = l
+        .warnings
+        .iter()
+        .filter(|w| w.contains("materials["))
+        .collect();
+    assert!(
+        about.len() == 1
+            && about[0].contains("materials[0].emissiveTexture")
+            && about[0].contains("TEXCOORD_1"),
+        "{:?}",
+        l.warnings
+    );
 }

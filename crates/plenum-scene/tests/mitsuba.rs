@@ -601,10 +601,7 @@ fn bitmap_wrap_modes() {
             panic!("expected a diffuse material");
         };
         for (u, want) in [-0.25, 1.25].into_iter().zip(want) {
-            let at = TextureCoords {
-                uv: [u, 0.5],
-                object_point: Vec3::ZERO,
-            };
+            let at = TextureCoords::new([u, 0.5], Vec3::ZERO);
             let got = d.reflectance.rgb(&at).g;
             assert!((got - want).abs() < 1e-6, "{mode} at u = {u}: {got}");
         }

@@ -786,10 +786,7 @@ Shape "sphere"
 Material "conductor" "texture roughness" "quarter"
 Shape "sphere"
 "#;
-    let at = |u: f64, v: f64| TextureCoords {
-        uv: [u, v],
-        object_point: Vec3::ZERO,
-    };
+    let at = |u: f64, v: f64| TextureCoords::new([u, v], Vec3::ZERO);
     let check = |l: &LoadedScene, what: &str| {
         let material =
             |i: usize| &l.scene.materials[l.scene.geometry.primitives[i].material as usize];
@@ -855,10 +852,7 @@ Shape "sphere"
         else {
             panic!("expected a diffuse material");
         };
-        let at = TextureCoords {
-            uv: [1.25, 0.5],
-            object_point: Vec3::ZERO,
-        };
+        let at = TextureCoords::new([1.25, 0.5], Vec3::ZERO);
         let got = d.reflectance.rgb(&at).g;
         assert!((got - want).abs() < 1e-6, "{wrap}: {got}");
     }
@@ -1101,4 +1095,244 @@ Shape "trianglemesh" "point3 P" [ 0 0 2  2 0 2  2 2 2 ] "integer indices" [ 0 1 
     close(at(1, Vec3::new(1.0, 0.5, 1.0)), [0.5, 0.25]);
     close(at(2, Vec3::new(2.0, 2.0, 2.0)), [1.0, 1.0]);
     close(at(2, Vec3::new(2.0, 0.0, 2.0)), [1.0, 0.0]);
+}
+
+#[test]
+fn procedural_textures_and_mappings_follow_pbrt_v4() {
+    use plenum_core::material::{FloatTexture, Material};
+    use plenum_core::math::Vec3;
+    use plenum_core::texture::{noise, Noise, Texture, TextureCoords};
+    // Textures defined in a space of their own (moved by (0, 0, 5), scaled by 2) and in
+    // the world; each a material of its own sphere, in order.
+    let text = r#"WorldBegin
+LightSource "point" "rgb I" [ 1 1 1 ]
+AttributeBegin
+  Translate 0 0 5
+  Scale 2 2 2
+  Texture "noise" "float" "fbm" "integer octaves" 4 "float roughness" 0.6
+  Texture "cubes" "spectrum" "checkerboard" "integer dimension" 3 "rgb tex1" [ 1 0 0 ] "rgb tex2" [ 0 0 1 ]
+  Texture "globe" "spectrum" "bilerp" "string mapping" "spherical" "rgb v00" [ 0 0 0 ] "rgb v10" [ 1 0 0 ] "rgb v01" [ 0 1 0 ] "rgb v11" [ 1 1 0 ]
+  Texture "can" "spectrum" "bilerp" "string mapping" "cylindrical" "rgb v00" [ 0 0 0 ] "rgb v10" [ 1 0 0 ] "rgb v01" [ 0 1 0 ] "rgb v11" [ 1 1 0 ]
+  Texture "stone" "spectrum" "marble" "float scale" 3 "float variation" 0.4 "integer octaves" 5
+  Texture "wind" "float" "windy"
+  Texture "wrinkles" "float" "wrinkled" "float roughness" 0.4 "integer octaves" 3
+AttributeEnd
+Texture "plane" "spectrum" "bilerp" "string mapping" "planar" "vector3 v1" [ 1 0 0 ] "vector3 v2" [ 0 0 1 ] "float udelta" 0.25 "float vdelta" -1 "rgb v00" [ 0 0 0 ] "rgb v10" [ 1 0 0 ] "rgb v01" [ 0 1 0 ] "rgb v11" [ 1 1 0 ]
+Texture "shifted" "spectrum" "bilerp" "float uscale" 2 "float vscale" -3 "float udelta" 0.5 "float vdelta" 4 "rgb v00" [ 0 0 0 ] "rgb v10" [ 1 0 0 ] "rgb v01" [ 0 1 0 ] "rgb v11" [ 1 1 0 ]
+Texture "dots" "spectrum" "dots" "float uscale" 3 "float vscale" 3 "rgb inside" [ 1 0 0 ] "rgb outside" [ 0 1 0 ]
+Texture "red" "spectrum" "constant" "rgb value" [ 1 0 0 ]
+Texture "textured checks" "spectrum" "checkerboard" "texture tex1" "globe" "rgb tex2" [ 0 0 1 ]
+AttributeBegin
+  Rotate 90 1 0 0
+  Texture "facing" "spectrum" "directionmix" "texture tex1" "red" "rgb tex2" [ 0 0 1 ] "vector3 dir" [ 0 0 2 ]
+AttributeEnd
+Material "conductor" "texture roughness" "noise"
+Shape "sphere"
+Material "diffuse" "texture reflectance" "cubes"
+Shape "sphere"
+Material "diffuse" "texture reflectance" "globe"
+Shape "sphere"
+Material "diffuse" "texture reflectance" "can"
+Shape "sphere"
+Material "diffuse" "texture reflectance" "stone"
+Shape "sphere"
+Material "conductor" "texture roughness" "wind"
+Shape "sphere"
+Material "conductor" "texture roughness" "wrinkles"
+Shape "sphere"
+Material "diffuse" "texture reflectance" "plane"
+Shape "sphere"
+Material "diffuse" "texture reflectance" "shifted"
+Shape "sphere"
+Material "diffuse" "texture reflectance" "dots"
+Shape "sphere"
+Material "diffuse" "texture reflectance" "facing"
+Shape "sphere"
+Material "diffuse" "texture reflectance" "textured checks"
+Shape "sphere"
+"#;
+    // The texture space of the first block: world p is (p − (0, 0, 5)) / 2 there.
+    let to_texture = |p: Vec3| (p - Vec3::new(0.0, 0.0, 5.0)) * 0.5;
+    let at = |p: Vec3, uv: [f64; 2], n: Vec3| TextureCoords {
+        object_point: Vec3::new(9.0, 9.0, 9.0),
+        normal: n,
+        ..TextureCoords::new(uv, p)
+    };
+    let check = |l: &LoadedScene, what: &str| {
+        let material =
+            |i: usize| &l.scene.materials[l.scene.geometry.primitives[i].material as usize];
+        let rgb = |i: usize, c: &TextureCoords| match material(i) {
+            Material::Diffuse(d) => {
+                let c = d.reflectance.rgb(c);
+                [c.r, c.g, c.b]
+            }
+            m => panic!("{what}: expected a diffuse material, found {m:?}"),
+        };
+        let float = |i: usize, c: &TextureCoords| match material(i) {
+            Material::Conductor(m) => match &m.roughness.u {
+                FloatTexture::Texture(t) => {
+                    let c = t.evaluate(c);
+                    (c.r + c.g + c.b) / 3.0
+                }
+                t => panic!("{what}: expected a texture, found {t:?}"),
+            },
+            m => panic!("{what}: expected a conductor, found {m:?}"),
+        };
+        let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 1e-9);
+        let (n, uv) = (Vec3::Z, [0.3, 0.6]);
+        // fBm at the point in the texture's space (not the object's, not the world's).
+        for p in [Vec3::new(0.3, 1.2, 4.1), Vec3::new(-2.0, 0.7, 6.3)] {
+            let want = noise::fbm(to_texture(p), 0.6, 4);
+            assert!(
+                (float(0, &at(p, uv, n)) - want).abs() < 1e-9,
+                "{what}: fbm at {p:?}"
+            );
+            let want = Noise::Windy.evaluate(to_texture(p)).r;
+            assert!(
+                (float(5, &at(p, uv, n)) - want).abs() < 1e-9,
+                "{what}: windy"
+            );
+            let want = noise::turbulence(to_texture(p), 0.4, 3);
+            assert!(
+                (float(6, &at(p, uv, n)) - want).abs() < 1e-9,
+                "{what}: wrinkled"
+            );
+            let marble = Noise::Marble {
+                omega: 0.5,
+                octaves: 5,
+                scale: 3.0,
+                variation: 0.4,
+            };
+            let c = marble.evaluate(to_texture(p));
+            assert!(
+                close(rgb(4, &at(p, uv, n)), [c.r, c.g, c.b]),
+                "{what}: marble"
+            );
+        }
+        // Cubes of side 2 from z = 5: tex1 (red) where the cell indices sum to an even number.
+        let cube = |x: f64, z: f64| rgb(1, &at(Vec3::new(x, 0.5, z), uv, n));
+        assert!(close(cube(0.5, 5.5), [1.0, 0.0, 0.0]), "{what}");
+        assert!(close(cube(2.5, 5.5), [0.0, 0.0, 1.0]), "{what}");
+        assert!(close(cube(0.5, 4.5), [0.0, 0.0, 1.0]), "{what}");
+        // The bilerp ramps show (s, t) as (red, green).
+        let st = |i: usize, p: Vec3, uv: [f64; 2]| {
+            let c = rgb(i, &at(p, uv, n));
+            assert!(c[2].abs() < 1e-9);
+            [c[0], c[1]]
+        };
+        let near = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-9;
+        // Spherical about (0, 0, 5): +y is θ = π/2, φ = π/2; −x is φ = π; straight up θ = 0.
+        assert!(
+            near(st(2, Vec3::new(0.0, 3.0, 5.0), uv), [0.5, 0.25]),
+            "{what}"
+        );
+        assert!(
+            near(st(2, Vec3::new(-1.0, 0.0, 5.0), uv), [0.5, 0.5]),
+            "{what}"
+        );
+        assert!(
+            near(st(2, Vec3::new(0.0, 0.0, 9.0), uv), [0.0, 0.0]),
+            "{what}"
+        );
+        // Cylindrical: s = (π + atan2(y, x)) / 2π, t = z in the texture's space.
+        let got = st(3, Vec3::new(0.0, 2.0, 6.0), uv);
+        assert!(near(got, [0.75, 0.5]), "{what}: {got:?}");
+        // Planar (in the world): s = 0.25 + x, t = −1 + z.
+        let got = st(7, Vec3::new(0.5, 7.0, 1.25), uv);
+        assert!(near(got, [0.75, 0.25]), "{what}: {got:?}");
+        // (u, v) scaled and offset: (2u + 0.5, −3v + 4).
+        let got = st(8, Vec3::ZERO, [0.1, 1.2]);
+        assert!(near(got, [0.7, 0.4]), "{what}: {got:?}");
+        // Dots over (3u, 3v). pbrt-v4 shows `outside` in the dots and `inside` around them.
+        let dot = |u: f64, v: f64| {
+            Texture::Dots
+                .evaluate(&at(Vec3::ZERO, [3.0 * u, 3.0 * v], n))
+                .r
+        };
+        let grid =
+            (0..100).flat_map(|i| (0..100).map(move |j| (i as f64 * 0.0137, j as f64 * 0.0113)));
+        let (mut dots, mut plain) = (0, 0);
+        for (u, v) in grid {
+            let c = rgb(9, &at(Vec3::ZERO, [u, v], n));
+            if dot(u, v) == 1.0 {
+                dots += 1;
+                assert!(
+                    close(c, [0.0, 1.0, 0.0]),
+                    "{what}: in a dot at {u} {v}: {c:?}"
+                );
+            } else {
+                plain += 1;
+                assert!(close(c, [1.0, 0.0, 0.0]), "{what}");
+            }
+        }
+        assert!(dots > 100 && plain > 100, "{dots} {plain}");
+        // The direction (0, 0, 2) turned by 90° about x: −y. A normal along it shows tex1,
+        // one across it tex2, between them |n·d| of tex1.
+        let face = |n: Vec3| rgb(10, &at(Vec3::ZERO, uv, n));
+        assert!(close(face(Vec3::Y), [1.0, 0.0, 0.0]), "{what}");
+        assert!(close(face(Vec3::Z), [0.0, 0.0, 1.0]), "{what}");
+        assert!(
+            close(face(Vec3::new(0.0, 0.6, 0.8)), [0.6, 0.0, 0.4]),
+            "{what}"
+        );
+        // A checkerboard of a texture (the spherical ramp) and a colour: the ramp, at the
+        // hit's own point, on tex1's squares.
+        let p = Vec3::new(0.0, 3.0, 5.0);
+        assert!(
+            close(rgb(11, &at(p, [0.5, 0.5], n)), [0.5, 0.25, 0.0]),
+            "{what}"
+        );
+        assert!(
+            close(rgb(11, &at(p, [1.5, 0.5], n)), [0.0, 0.0, 1.0]),
+            "{what}"
+        );
+    };
+    let l = load(text);
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    check(&l, "pbrt");
+    // `plenum convert` writes them in the native format, which reads back alike.
+    let written = plenum_scene::to_toml(&l.scene, &l.defaults);
+    for kind in [
+        "fbm",
+        "marble",
+        "windy",
+        "wrinkled",
+        "dots",
+        "directionmix",
+        "mapped",
+    ] {
+        assert!(written.contains(&format!("texture = \"{kind}\"")), "{kind}");
+    }
+    let back = load_files(&[("scene.toml", written.as_bytes())]).unwrap_or_else(|e| panic!("{e}"));
+    check(&back, "native");
+}
+
+#[test]
+fn options_are_read_and_what_plenum_lacks_is_warned() {
+    let scene =
+        |options: &str| format!("{options}\nWorldBegin\nLightSource \"point\"\nShape \"sphere\"\n");
+    let l = load(&scene(
+        "Option \"seed\" 7\nOption \"string rendercoordsys\" \"world\"\nOption \"wavefront\" true\nOption \"disable_pixel_jitter\" false",
+    ));
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    let l = load(&scene(
+        "Option \"forcediffuse\" true\nOption \"disablepixeljitter\" [ true ]",
+    ));
+    assert_eq!(l.warnings.len(), 2, "{:?}", l.warnings);
+    assert!(l.warnings[0].contains("scene.pbrt:1:1") && l.warnings[0].contains("diffuse"));
+    assert!(l.warnings[1].contains("scene.pbrt:2:1"));
+    let e = error(&scene("Option \"sed\" 7")).to_string();
+    assert!(
+        e.contains("scene.pbrt:1:8") && e.contains("did you mean `seed`"),
+        "{e}"
+    );
+    let e = error(&scene("Option \"seed\" \"seven\"")).to_string();
+    assert!(
+        e.contains("scene.pbrt:1:15") && e.contains("whole number"),
+        "{e}"
+    );
+    let e = error(&scene("Option \"rendercoordsys\" \"screen\"")).to_string();
+    assert!(e.contains("unknown rendering space"), "{e}");
+    let e = error(&scene("Option \"seed\"")).to_string();
+    assert!(e.contains("needs a value"), "{e}");
 }

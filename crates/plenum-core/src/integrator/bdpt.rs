@@ -530,7 +530,7 @@ impl<'a> BidirectionalPathTracer<'a> {
             };
             if mode == TransportMode::Radiance {
                 v.le = match v.light {
-                    Some(light) => scene.lights.emitted(light, &it.texture, wl),
+                    Some(light) => scene.lights.emitted(light, &it.texture(), wl),
                     None => scene
                         .phong_emission(&it, wl)
                         .unwrap_or(SampledSpectrum::ZERO),

@@ -99,7 +99,7 @@ pub(super) fn emitted_mis(
         return SampledSpectrum::ZERO;
     }
     let pdf_light = scene.lights.sampler.pmf(light) * l.pdf_li(from, it.p, it.n);
-    scene.lights.emitted(light, &it.texture, wl)
+    scene.lights.emitted(light, &it.texture(), wl)
         * power_heuristic(bsdf_samples * pdf_bsdf, pdf_light)
 }
 

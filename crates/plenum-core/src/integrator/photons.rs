@@ -95,7 +95,7 @@ pub(super) fn emitted(
 ) -> SampledSpectrum {
     if let Some(light) = scene.area_light(prim) {
         if scene.lights[light as usize].emits_toward(it.n, wo) {
-            return scene.lights.emitted(light, &it.texture, wl);
+            return scene.lights.emitted(light, &it.texture(), wl);
         }
     } else if let Some(ke) = scene.phong_emission(it, wl) {
         return ke;

@@ -161,7 +161,7 @@ impl<'a> Whitted<'a> {
                 let light = &self.scene.lights[l as usize];
                 if light.emits_toward(it.n, v) {
                     color += light
-                        .textured_radiance_at(&it.texture)
+                        .textured_radiance_at(&it.texture())
                         .unwrap_or(light.rgb());
                 }
             }

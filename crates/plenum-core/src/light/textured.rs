@@ -22,11 +22,24 @@ pub struct EmissionTexture {
 
 #[derive(Clone, Debug)]
 enum EmitterCoords {
-    /// Per triangle of [`Emitter::Triangles`], in its order: the corners in the shape's
-    /// coordinates and their (u, v).
-    Corners(Vec<[(Vec3, [f64; 2]); 3]>),
+    /// Per triangle of [`Emitter::Triangles`], in its order.
+    Corners(Vec<Corners>),
     /// The shape (a sphere or disk) in its own coordinates, and the world-to-object map.
-    Shape { shape: Shape, to_object: Transform },
+    Shape {
+        shape: Shape,
+        to_object: Transform,
+        to_world: Transform,
+    },
+}
+
+/// A triangle's corners in the shape's coordinates and in the world, their (u, v), and
+/// its world normal.
+#[derive(Clone, Debug)]
+struct Corners {
+    object: [Vec3; 3],
+    world: [Vec3; 3],
+    uv: [[f64; 2]; 3],
+    normal: Vec3,
 }
 
 /// A point of an emitter: where a sample landed.
@@ -49,7 +62,9 @@ impl EmissionTexture {
         to_world: &Transform,
     ) -> Option<EmissionTexture> {
         let coords = match emitter {
-            Emitter::Triangles { triangles, .. } => {
+            Emitter::Triangles {
+                triangles, normals, ..
+            } => {
                 let parts = Emitter::object_triangles(shape, to_world)?;
                 if parts.len() != triangles.len() {
                     return None;
@@ -57,13 +72,20 @@ impl EmissionTexture {
                 EmitterCoords::Corners(
                     parts
                         .into_iter()
-                        .map(|(part, t)| t.map(|p| (p, shape.uv_at(p, part))))
+                        .zip(normals)
+                        .map(|((part, object), &normal)| Corners {
+                            object,
+                            world: object.map(|p| to_world.point(p)),
+                            uv: object.map(|p| shape.uv_at(p, part)),
+                            normal,
+                        })
                         .collect(),
                 )
             }
             _ => EmitterCoords::Shape {
                 shape: shape.clone(),
                 to_object: to_world.inverted(),
+                to_world: to_world.clone(),
             },
         };
         Some(EmissionTexture { texture, coords })
@@ -74,27 +96,43 @@ impl EmissionTexture {
         match (&self.coords, at) {
             (EmitterCoords::Corners(corners), EmitterPoint::Triangle { triangle, b }) => {
                 let w = [b[0], b[1], 1.0 - b[0] - b[1]];
-                let [(p0, t0), (p1, t1), (p2, t2)] = corners[triangle];
+                let c = &corners[triangle];
+                let mix = |p: &[Vec3; 3]| p[0] * w[0] + p[1] * w[1] + p[2] * w[2];
+                let t = &c.uv;
                 TextureCoords {
                     uv: [
-                        t0[0] * w[0] + t1[0] * w[1] + t2[0] * w[2],
-                        t0[1] * w[0] + t1[1] * w[1] + t2[1] * w[2],
+                        t[0][0] * w[0] + t[1][0] * w[1] + t[2][0] * w[2],
+                        t[0][1] * w[0] + t[1][1] * w[1] + t[2][1] * w[2],
                     ],
-                    object_point: p0 * w[0] + p1 * w[1] + p2 * w[2],
+                    object_point: mix(&c.object),
+                    point: mix(&c.world),
+                    normal: c.normal,
                 }
             }
-            (EmitterCoords::Shape { shape, to_object }, EmitterPoint::World(q)) => {
+            (
+                EmitterCoords::Shape {
+                    shape,
+                    to_object,
+                    to_world,
+                },
+                EmitterPoint::World(q),
+            ) => {
                 let p = to_object.point(q);
+                // The normal of a sphere (from its centre) or a disk.
+                let n = match shape {
+                    Shape::Sphere(s) => p - s.center,
+                    Shape::Disk(d) => d.normal,
+                    _ => Vec3::Z,
+                };
                 TextureCoords {
                     uv: shape.uv_at(p, 0),
                     object_point: p,
+                    point: q,
+                    normal: to_world.normal(n).normalized(),
                 }
             }
             // Not a point of this emitter (cannot happen for a texture made for it).
-            (_, _) => TextureCoords {
-                uv: [0.0, 0.0],
-                object_point: Vec3::ZERO,
-            },
+            (_, _) => TextureCoords::new([0.0, 0.0], Vec3::ZERO),
         }
     }
 
@@ -196,7 +234,11 @@ mod tests {
                 let (q, n, at) = emitter
                     .sample_point([rng.uniform(), rng.uniform()])
                     .unwrap();
-                let got = t.coords(at).uv;
+                let coords = t.coords(at);
+                let got = coords.uv;
+                // The world point and normal are the sampled ones.
+                assert!((coords.point - q).length() < 1e-9 * (1.0 + q.length()));
+                assert!((coords.normal.dot(n).abs() - 1.0).abs() < 1e-9);
                 // A ray down the normal onto the point, in the shape's coordinates.
                 let (p, d) = (to_object.point(q + n * 1e-3), to_object.vector(-n));
                 let ray = Ray::new(p, d);

@@ -71,10 +71,7 @@ mod tests {
     use crate::texture::Texture;
 
     fn at(u: f64) -> TextureCoords {
-        TextureCoords {
-            uv: [u, 0.25],
-            object_point: Vec3::ZERO,
-        }
+        TextureCoords::new([u, 0.25], Vec3::ZERO)
     }
 
     #[test]

@@ -88,10 +88,12 @@ impl Bump {
             }
             Bump::HeightMap { height, scale } => {
                 let h = |du: f64, dv: f64| {
-                    let [ou, ov] = dp.object;
+                    let ([ou, ov], [wu, wv]) = (dp.object, dp.world);
                     let shifted = TextureCoords {
                         uv: [at.uv[0] + du, at.uv[1] + dv],
                         object_point: at.object_point + ou * du + ov * dv,
+                        point: at.point + wu * du + wv * dv,
+                        ..*at
                     };
                     height.evaluate(&shifted) * scale
                 };
@@ -135,10 +137,7 @@ mod tests {
     use crate::texture::Texture;
 
     fn coords(u: f64, v: f64) -> TextureCoords {
-        TextureCoords {
-            uv: [u, v],
-            object_point: Vec3::new(u, v, 0.0),
-        }
+        TextureCoords::new([u, v], Vec3::new(u, v, 0.0))
     }
 
     fn flat_square(scale: f64) -> UvDerivatives {

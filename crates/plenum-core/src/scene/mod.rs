@@ -74,11 +74,11 @@ impl Scene {
             let weights = [1.0 - b1 - b2, b1, b2];
             let parts = [0, 1, 2].map(|i| {
                 let m = &self.materials[ids[triangle[i] as usize] as usize];
-                (weights[i], m.coefficients(&it.texture))
+                (weights[i], m.coefficients(&it.texture()))
             });
             return Coefficients::blend(&parts);
         }
-        self.materials.coefficients(p.material, &it.texture)
+        self.materials.coefficients(p.material, &it.texture())
     }
 
     /// The emission k_e of a Phong material at a hit on a primitive that is not a light's
@@ -92,7 +92,7 @@ impl Scene {
         if m.emissive.is_black() {
             return None;
         }
-        Some(rgb_radiance(m.emissive.evaluate(&it.texture), wl))
+        Some(rgb_radiance(m.emissive.evaluate(&it.texture()), wl))
     }
 
     /// Whether nothing in the scene gives light (no light source or emitting surface, no
@@ -134,7 +134,7 @@ impl Scene {
         if p.vertex_materials.is_some() {
             let k = self.coefficients(it);
             let phong = Material::Phong(PhongMaterial::constant(&k));
-            return match phong.scattering(&it.texture, wl, solid, 0.5) {
+            return match phong.scattering(&it.texture(), wl, solid, 0.5) {
                 Scattering::Bxdf(b) => self.finish_bsdf(b, it),
                 Scattering::Other(_) => None,
             };
@@ -144,7 +144,7 @@ impl Scene {
         }
         let b = self
             .materials
-            .bxdf(p.material, &it.texture, wl, solid, || hash_hit(it.p, wo))?;
+            .bxdf(p.material, &it.texture(), wl, solid, || hash_hit(it.p, wo))?;
         self.finish_bsdf(b, it)
     }
 

@@ -44,10 +44,27 @@ pub struct Interaction {
     pub n: Vec3,
     /// Unit shading normal, on the same side as `n`.
     pub shading_n: Vec3,
-    pub texture: TextureCoords,
+    /// Texture coordinates (when asked for).
+    pub uv: [f64; 2],
+    /// The hit point in the object's coordinates.
+    pub object_point: Vec3,
     pub primitive: u32,
     /// The shape's record of the hit: which triangle, and where in it.
     pub hit: HitRecord,
+}
+
+impl Interaction {
+    /// Where textures are looked up at this hit. (Built when asked: storing it would
+    /// repeat the point and normal in every hit the integrators pass around.)
+    #[inline]
+    pub fn texture(&self) -> TextureCoords {
+        TextureCoords {
+            uv: self.uv,
+            object_point: self.object_point,
+            point: self.p,
+            normal: self.n,
+        }
+    }
 }
 
 impl Primitive {
@@ -91,7 +108,7 @@ impl Primitive {
         let mut t_from = 0.0;
         for _ in 0..MAX_CUTS {
             let it = self.interaction(&from, &hit, 0, want_uv);
-            if alpha.keeps(&it.texture, || super::hash_hit(it.p, ray.direction)) {
+            if alpha.keeps(&it.texture(), || super::hash_hit(it.p, ray.direction)) {
                 hit.t += t_from;
                 return Some(hit);
             }
@@ -128,20 +145,25 @@ impl Primitive {
         self.placed(ray.time, |placement| match placement {
             None => {
                 let g = self.shape.surface(ray, hit, want_uv);
-                let texture = TextureCoords {
-                    uv: g.uv,
-                    object_point: g.p,
-                };
                 let shading_n = match &self.bump {
                     None => g.shading_n,
-                    Some(bump) => self.bumped(bump, hit, &g, &texture, g.n, g.shading_n, None),
+                    Some(bump) => {
+                        let texture = TextureCoords {
+                            uv: g.uv,
+                            object_point: g.p,
+                            point: g.p,
+                            normal: g.n,
+                        };
+                        self.bumped(bump, hit, &g, &texture, g.n, g.shading_n, None)
+                    }
                 };
                 Interaction {
                     p: g.p,
                     p_error: g.p_error,
                     n: g.n,
                     shading_n,
-                    texture,
+                    uv: g.uv,
+                    object_point: g.p,
                     primitive,
                     hit: *hit,
                 }
@@ -168,14 +190,16 @@ impl Primitive {
                 let object_error = g.n.abs().dot(g.p_error + t.inverse_error(p))
                     + inverse_mismatch * g.n.abs().dot(Vec3::ONE);
                 let p_error = p_error + n.abs() * (object_error / stretch * (1.0 + gamma(4)));
-                let texture = TextureCoords {
-                    uv: g.uv,
-                    object_point: g.p,
-                };
                 let shading_n = t.normal(g.shading_n).normalized();
                 let shading_n = match &self.bump {
                     None => shading_n,
                     Some(bump) => {
+                        let texture = TextureCoords {
+                            uv: g.uv,
+                            object_point: g.p,
+                            point: p,
+                            normal: n,
+                        };
                         self.bumped(bump, &local_hit, &g, &texture, n, shading_n, Some(t))
                     }
                 };
@@ -184,7 +208,8 @@ impl Primitive {
                     p_error,
                     n,
                     shading_n,
-                    texture,
+                    uv: g.uv,
+                    object_point: g.p,
                     primitive,
                     hit: *hit,
                 }

@@ -13,7 +13,8 @@ use plenum_core::geometry::TriangleMesh;
 use plenum_core::material::FloatTexture;
 use plenum_core::math::{Matrix4, Transform, Vec3};
 use plenum_core::scene::{MaterialId, SceneBuilder};
-use plenum_core::texture::{ImageTexture, Texture, Wrap};
+use plenum_core::texture::noise::MAX_OCTAVES;
+use plenum_core::texture::{ImageTexture, Mapping, Noise, Texture, Wrap};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -210,8 +211,28 @@ impl<'s> Reader<'s> {
                 v,
                 "a texture",
                 &[
-                    "texture", "even", "odd", "scale", "file", "channel", "encoding", "corners",
-                    "textures", "amount", "wrap",
+                    "texture",
+                    "even",
+                    "odd",
+                    "scale",
+                    "file",
+                    "channel",
+                    "encoding",
+                    "corners",
+                    "textures",
+                    "amount",
+                    "wrap",
+                    "omega",
+                    "octaves",
+                    "variation",
+                    "inside",
+                    "outside",
+                    "direction",
+                    "mapping",
+                    "transform",
+                    "delta",
+                    "axes",
+                    "of",
                 ],
             )?;
             let k = f.required("texture")?;
@@ -358,15 +379,175 @@ impl<'s> Reader<'s> {
                     .constant_value()
                     .map_or(combined, Texture::Constant))
             }
+            "fbm" | "wrinkled" | "windy" | "marble" => {
+                let keys: &[&str] = match kind.0.as_str() {
+                    "windy" => &["texture"],
+                    "marble" => &["texture", "omega", "octaves", "scale", "variation"],
+                    _ => &["texture", "omega", "octaves"],
+                };
+                let f = self.src.table(v, "a noise texture", keys)?;
+                let omega = f.number_or("omega", 0.5)?;
+                let octaves = f.count("octaves")?.unwrap_or(8);
+                if octaves > MAX_OCTAVES {
+                    return Err(self.src.error(
+                        f.required("octaves")?.span(),
+                        format!("expected at most {MAX_OCTAVES} octaves (finer ones are below f64's precision), found {octaves}"),
+                    ));
+                }
+                Ok(Texture::Noise(Arc::new(match kind.0.as_str() {
+                    "fbm" => Noise::Fbm { omega, octaves },
+                    "wrinkled" => Noise::Wrinkled { omega, octaves },
+                    "windy" => Noise::Windy,
+                    _ => Noise::Marble {
+                        omega,
+                        octaves,
+                        scale: f.number_or("scale", 1.0)?,
+                        variation: f.number_or("variation", 0.2)?,
+                    },
+                })))
+            }
+            "dots" => {
+                let f = self
+                    .src
+                    .table(v, "a dots texture", &["texture", "inside", "outside"])?;
+                let part = |key: &str, default: Color| {
+                    f.get(key)
+                        .map_or(Ok(Texture::Constant(default)), |t| self.texture(t))
+                };
+                let (inside, outside) = (
+                    part("inside", Color::WHITE)?,
+                    part("outside", Color::BLACK)?,
+                );
+                Ok(match (&inside, &outside) {
+                    (Texture::Constant(Color::WHITE), Texture::Constant(Color::BLACK)) => {
+                        Texture::Dots
+                    }
+                    _ => Texture::Mix(Arc::new([outside, inside, Texture::Dots])),
+                })
+            }
+            "directionmix" => {
+                let f = self.src.table(
+                    v,
+                    "a directionmix texture",
+                    &["texture", "textures", "direction"],
+                )?;
+                let textures = f.required("textures")?;
+                let list = self.src.array(textures, "two textures or colours")?;
+                let [a, b] = list else {
+                    return Err(self.src.error(
+                        textures.span(),
+                        format!("expected two textures or colours, found {}", list.len()),
+                    ));
+                };
+                let d = f.direction("direction", None)?.normalized();
+                Ok(Texture::DirectionMix(Arc::new((
+                    d,
+                    [self.texture(a)?, self.texture(b)?],
+                ))))
+            }
+            "mapped" => self.mapped_texture(v),
             other => {
                 let e = self.src.error(kind.1, format!("unknown texture `{other}`"));
-                let kinds = ["checker", "checker3d", "image", "bilerp", "scale", "mix"];
+                let kinds = [
+                    "checker",
+                    "checker3d",
+                    "image",
+                    "bilerp",
+                    "scale",
+                    "mix",
+                    "directionmix",
+                    "fbm",
+                    "wrinkled",
+                    "windy",
+                    "marble",
+                    "dots",
+                    "mapped",
+                ];
                 Err(match did_you_mean(other, kinds) {
                     Some(s) => e.with_help(format!("did you mean `{s}`?")),
                     None => e.with_help(format!("expected one of: {}", kinds.join(", "))),
                 })
             }
         }
+    }
+
+    /// A texture looked up through a mapping: `{ texture = "mapped", mapping = …, of = T }`,
+    /// the mapping's space placed by `transform` (texture space to world).
+    fn mapped_texture(&self, v: &Value<'s>) -> Result<Texture> {
+        let f = self.src.table(
+            v,
+            "a mapped texture",
+            &[
+                "texture",
+                "mapping",
+                "transform",
+                "scale",
+                "delta",
+                "axes",
+                "of",
+            ],
+        )?;
+        let inner = self.texture(f.required("of")?)?;
+        let mapping_value = f.required("mapping")?;
+        let kind = self.src.string(mapping_value)?;
+        let to_texture = match f.get("transform") {
+            None => Transform::IDENTITY,
+            Some(t) => self.transform(t)?.inverted(),
+        };
+        let pair = |key: &str, default: [f64; 2]| -> Result<[f64; 2]> {
+            f.get(key)
+                .map_or(Ok(default), |p| self.src.numbers::<2>(p, "two numbers"))
+        };
+        // Only the keys a mapping reads.
+        let allowed: &[&str] = match kind {
+            "uv" => &["scale", "delta"],
+            "planar" => &["transform", "axes", "delta"],
+            _ => &["transform"],
+        };
+        for key in ["transform", "scale", "delta", "axes"] {
+            if let Some(given) = f.get(key).filter(|_| !allowed.contains(&key)) {
+                return Err(self.src.error(
+                    given.span(),
+                    format!("the `{kind}` mapping takes no `{key}`"),
+                ));
+            }
+        }
+        let mapping = match kind {
+            "uv" => Mapping::Uv {
+                scale: pair("scale", [1.0, 1.0])?,
+                delta: pair("delta", [0.0, 0.0])?,
+            },
+            "spherical" => Mapping::Spherical(to_texture),
+            "cylindrical" => Mapping::Cylindrical(to_texture),
+            "solid" => Mapping::Solid(to_texture),
+            "planar" => {
+                let axes = match f.get("axes") {
+                    None => [Vec3::X, Vec3::Y],
+                    Some(a) => match self.src.array(a, "two vectors [s, t]")? {
+                        [s, t] => [self.src.vec3(s)?, self.src.vec3(t)?],
+                        list => {
+                            return Err(self.src.error(
+                                a.span(),
+                                format!("expected two vectors [s, t], found {}", list.len()),
+                            ))
+                        }
+                    },
+                };
+                Mapping::Planar {
+                    to_texture,
+                    axes,
+                    delta: pair("delta", [0.0, 0.0])?,
+                }
+            }
+            other => {
+                let kinds = ["uv", "spherical", "cylindrical", "planar", "solid"];
+                return Err(self
+                    .src
+                    .error(mapping_value.span(), format!("unknown mapping `{other}`"))
+                    .with_help(format!("expected one of: {}", kinds.join(", "))));
+            }
+        };
+        Ok(Texture::Mapped(Arc::new((mapping, inner))))
     }
 
     /// The `type` of a light or object, checked against the known kinds.

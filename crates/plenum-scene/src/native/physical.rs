@@ -287,12 +287,19 @@ impl<'s> Reader<'s> {
             t => FloatTexture::Texture(t),
         };
         let (u, v) = match v.get_ref() {
-            DeValue::Array(a) if a.len() == 2 => {
-                let [u, w] = self.src.numbers::<2>(v, "[u, v] roughness")?;
-                if u < 0.0 || w < 0.0 {
-                    return Err(self.src.error(v.span(), "expected roughness ≥ 0"));
-                }
-                (FloatTexture::Constant(u), FloatTexture::Constant(w))
+            // [u, v]: numbers or textures.
+            DeValue::Array(_) if self.src.array(v, "[u, v] roughness")?.len() == 2 => {
+                let a = self.src.array(v, "[u, v] roughness")?;
+                let one = |x: &Value<'s>| -> Result<FloatTexture> {
+                    let t = scalar(self.texture(x)?);
+                    match t {
+                        FloatTexture::Constant(r) if r < 0.0 => {
+                            Err(self.src.error(x.span(), "expected roughness ≥ 0"))
+                        }
+                        t => Ok(t),
+                    }
+                };
+                (one(&a[0])?, one(&a[1])?)
             }
             _ => {
                 let t = scalar(self.texture(v)?);

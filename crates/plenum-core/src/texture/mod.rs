@@ -1,6 +1,13 @@
 //! Textures: colours that vary over a surface. 2-D textures are looked up by the surface's
 //! (u, v); solid textures by the hit point in the object's own coordinates, so they move
-//! with the object.
+//! with the object (or, under a [`Mapping`], in a space of the texture's own).
+
+mod mapping;
+pub mod noise;
+mod procedural;
+
+pub use mapping::Mapping;
+use procedural::in_polka_dot;
 
 use crate::color::Color;
 use crate::math::Vec3;
@@ -29,6 +36,35 @@ pub enum Texture {
     Scale(Arc<[Texture; 2]>),
     /// (1 − t)·a + t·b with t the mean of the third texture's channels (pbrt-v4's `mix`).
     Mix(Arc<[Texture; 3]>),
+    /// t·a + (1 − t)·b with t = |n·d|, n the surface normal and d the unit direction given
+    /// (pbrt-v4's `directionmix`): a where the surface faces along d.
+    DirectionMix(Arc<(Vec3, [Texture; 2])>),
+    /// Noise patterns, solid (looked up at the object point).
+    Noise(Arc<Noise>),
+    /// Polka dots over (u, v) (pbrt-v4's `dots`), white on black: in the unit cells noise
+    /// chooses, a dot of radius 0.35 moved off the cell's centre by noise. (A `Mix` with it
+    /// as the amount puts textures in and between the dots.)
+    Dots,
+    /// The texture looked up where the mapping says.
+    Mapped(Arc<(Mapping, Texture)>),
+}
+
+/// Pbrt-v4's noise textures (section 10.6 of its book), by [`noise`]'s Perlin noise.
+#[derive(Clone, Debug)]
+pub enum Noise {
+    /// Fractional Brownian motion: octaves weighted by omega per octave.
+    Fbm { omega: f64, octaves: u32 },
+    /// Turbulence: fBm of the noise's magnitude.
+    Wrinkled { omega: f64, octaves: u32 },
+    /// Waves whose height is scaled by a slower fBm, the wind's strength.
+    Windy,
+    /// Marble: veins along y, bent by fBm, coloured by pbrt-v4's grey and blue spline.
+    Marble {
+        omega: f64,
+        octaves: u32,
+        scale: f64,
+        variation: f64,
+    },
 }
 
 /// Where a texture is looked up.
@@ -37,6 +73,23 @@ pub struct TextureCoords {
     pub uv: [f64; 2],
     /// The hit point in the object's coordinates.
     pub object_point: Vec3,
+    /// The hit point in the world.
+    pub point: Vec3,
+    /// The surface's unit geometric normal in the world (either side).
+    pub normal: Vec3,
+}
+
+impl TextureCoords {
+    /// At (u, v), the point `p` in the object and in the world, the normal along +z: for
+    /// tests and tools that look textures up outside a scene.
+    pub fn new(uv: [f64; 2], p: Vec3) -> Self {
+        TextureCoords {
+            uv,
+            object_point: p,
+            point: p,
+            normal: Vec3::Z,
+        }
+    }
 }
 
 impl Texture {
@@ -78,6 +131,14 @@ impl Texture {
                 let w = (amount.r + amount.g + amount.b) / 3.0;
                 t[0].evaluate(at) * (1.0 - w) + t[1].evaluate(at) * w
             }
+            Texture::DirectionMix(m) => {
+                let (d, [a, b]) = &**m;
+                let w = at.normal.dot(*d).abs().min(1.0);
+                a.evaluate(at) * w + b.evaluate(at) * (1.0 - w)
+            }
+            Texture::Noise(n) => n.evaluate(at.object_point),
+            Texture::Dots => Color::gray(in_polka_dot(at.uv) as u8 as f64),
+            Texture::Mapped(m) => m.1.evaluate(&m.0.apply(at)),
         }
     }
 
@@ -99,6 +160,11 @@ impl Texture {
                 let w = (amount.r + amount.g + amount.b) / 3.0;
                 Some(a * (1.0 - w) + b * w)
             }
+            Texture::DirectionMix(m) => {
+                let (a, b) = (m.1[0].constant_value()?, m.1[1].constant_value()?);
+                (a == b).then_some(a)
+            }
+            Texture::Mapped(m) => m.1.constant_value(),
             _ => None,
         }
     }
@@ -106,10 +172,15 @@ impl Texture {
     /// Whether the texture is looked up by (u, v) (rather than being constant or solid).
     pub fn needs_uv(&self) -> bool {
         match self {
-            Texture::Constant(_) | Texture::Checker3d { .. } => false,
-            Texture::Checker2d { .. } | Texture::Image(_) | Texture::Bilerp(_) => true,
+            Texture::Constant(_) | Texture::Checker3d { .. } | Texture::Noise(_) => false,
+            Texture::Checker2d { .. } | Texture::Image(_) | Texture::Bilerp(_) | Texture::Dots => {
+                true
+            }
             Texture::Scale(t) => t.iter().any(Texture::needs_uv),
             Texture::Mix(t) => t.iter().any(Texture::needs_uv),
+            Texture::DirectionMix(m) => m.1.iter().any(Texture::needs_uv),
+            // A mapping other than (u, v)'s makes the uv its texture reads.
+            Texture::Mapped(m) => m.0.needs_uv() && m.1.needs_uv(),
         }
     }
 
@@ -126,12 +197,16 @@ impl Texture {
             Texture::Bilerp(b) => b.0.iter().map(max).fold(0.0, f64::max),
             Texture::Scale(t) => t[0].max_component() * t[1].max_component(),
             Texture::Mix(t) => t[0].max_component().max(t[1].max_component()),
+            Texture::DirectionMix(m) => m.1[0].max_component().max(m.1[1].max_component()),
+            Texture::Dots => 1.0,
+            Texture::Noise(n) => n.max_value(),
+            Texture::Mapped(m) => m.1.max_component(),
         }
     }
 
     /// The texture's mean over (u, v): exact for constants, checkers, images and bilerps,
-    /// the product or mix of the operands' means for `Scale` and `Mix` (an estimate, what
-    /// weighing lights by their power needs).
+    /// the product or mix of the operands' means for `Scale` and `Mix`, and over a cube of
+    /// sample points for noise (an estimate, what weighing lights by their power needs).
     pub fn average(&self) -> Color {
         match self {
             Texture::Constant(c) => *c,
@@ -146,6 +221,10 @@ impl Texture {
                 let w = (m.r + m.g + m.b) / 3.0;
                 t[0].average() * (1.0 - w) + t[1].average() * w
             }
+            Texture::DirectionMix(m) => (m.1[0].average() + m.1[1].average()) * 0.5,
+            Texture::Dots => Color::gray(procedural::polka_dot_cover()),
+            Texture::Noise(n) => n.average(),
+            Texture::Mapped(m) => m.1.average(),
         }
     }
 
@@ -160,6 +239,10 @@ impl Texture {
             Texture::Bilerp(b) => b.0.iter().all(|c| c.is_black()),
             Texture::Scale(t) => t[0].is_black() || t[1].is_black(),
             Texture::Mix(t) => t[0].is_black() && t[1].is_black(),
+            Texture::DirectionMix(m) => m.1.iter().all(Texture::is_black),
+            Texture::Dots => false,
+            Texture::Noise(_) => false,
+            Texture::Mapped(m) => m.1.is_black(),
         }
     }
 }
@@ -285,10 +368,7 @@ mod tests {
     use super::*;
 
     fn at(u: f64, v: f64) -> TextureCoords {
-        TextureCoords {
-            uv: [u, v],
-            object_point: Vec3::new(u, v, 0.0),
-        }
+        TextureCoords::new([u, v], Vec3::new(u, v, 0.0))
     }
 
     #[test]
