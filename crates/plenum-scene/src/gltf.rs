@@ -755,7 +755,9 @@ impl<'a> Reader<'a> {
         let coat = Material::CoatedDiffuse(CoatedDiffuseMaterial {
             reflectance: base_color.clone(),
             roughness: roughness.clone(),
-            thickness: 0.01,
+            // glTF's layer absorbs nothing between coat and base (pbrt's default 0.01 of
+            // an absorbing medium would darken every glTF material by a few per cent).
+            thickness: 0.0,
             eta: coat_eta,
             albedo: SpectralTexture::constant(Color::BLACK, SpectrumKind::Albedo),
             g: 0.0,
@@ -867,7 +869,9 @@ impl<'a> Reader<'a> {
                                     Some(_) => Color::WHITE,
                                     None => emission,
                                 },
-                                true,
+                                // A single-sided material's back faces are culled: it
+                                // emits from its front only.
+                                p.material().double_sided(),
                                 1,
                             );
                             if let Some(t) = emission_texture.filter(|_| added) {

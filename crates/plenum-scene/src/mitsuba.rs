@@ -12,7 +12,7 @@ use crate::diagnostics::{did_you_mean, SceneError};
 use crate::RenderDefaults;
 use plenum_core::camera::{CameraSettings, Lens};
 use plenum_core::color::Color;
-use plenum_core::geometry::{Cuboid, Cylinder, Disk, Shape, Sphere, TriangleMesh};
+use plenum_core::geometry::{Cuboid, Cylinder, Disk, Shape, Sphere, TriangleMesh, UvMap};
 use plenum_core::integrator::IntegratorKind;
 use plenum_core::light::{Attenuation, Light};
 use plenum_core::material::{
@@ -1033,12 +1033,13 @@ impl<'d> Builder<'d> {
             }
             "disk" => {
                 let n = if flip { -Vec3::Z } else { Vec3::Z };
-                Shape::Disk(Disk::new(Vec3::ZERO, n, 1.0))
+                Shape::Disk(Disk::new(Vec3::ZERO, n, 1.0).with_uv_map(UvMap::Mitsuba))
             }
             "sphere" => {
                 flip_unsupported(self);
                 let center = self.vector(o, "center", Vec3::ZERO)?;
-                Shape::Sphere(Sphere::new(center, self.positive(o, "radius", 1.0)?))
+                let radius = self.positive(o, "radius", 1.0)?;
+                Shape::Sphere(Sphere::new(center, radius).with_uv_map(UvMap::Mitsuba))
             }
             "cube" => {
                 flip_unsupported(self);
@@ -1059,7 +1060,8 @@ impl<'d> Builder<'d> {
                         .error(&ob.loc, "the cylinder's p0 and p1 are the same point"));
                 };
                 // Mitsuba's cylinder is open at both ends.
-                let shape = Shape::Cylinder(Cylinder::new(radius, height, false));
+                let cylinder = Cylinder::new(radius, height, false).with_uv_map(UvMap::Mitsuba);
+                let shape = Shape::Cylinder(cylinder);
                 return self.place(o, shape, to_world.after(&frame));
             }
             "obj" | "ply" => {

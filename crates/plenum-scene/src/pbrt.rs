@@ -11,7 +11,7 @@ use crate::limits::MAX_NESTING;
 use crate::RenderDefaults;
 use plenum_core::camera::{CameraSettings, Lens};
 use plenum_core::color::Color;
-use plenum_core::geometry::{Cylinder, Disk, Partial, Shape, Sphere, TriangleMesh};
+use plenum_core::geometry::{Cylinder, Disk, Partial, Shape, Sphere, TriangleMesh, UvMap};
 use plenum_core::integrator::IntegratorKind;
 use plenum_core::light::{Attenuation, Light, Profile};
 use plenum_core::material::{
@@ -667,9 +667,47 @@ impl Parser {
             if let Some(s) = plenum_spectrum::named(name) {
                 return Ok(s);
             }
+            // Otherwise a file of (λ, value) pairs, as pbrt-v4 reads it: numbers separated
+            // by white space, `#` to the end of a line a comment.
+            let path = self.path_in(q.loc.file, name);
+            if let Ok(text) = std::fs::read_to_string(&path) {
+                let mut numbers = Vec::new();
+                for (i, line) in text.lines().enumerate() {
+                    let line = line.split('#').next().unwrap_or_default();
+                    for word in line.split_whitespace() {
+                        match word.parse::<f64>() {
+                            Ok(x) if x.is_finite() => numbers.push(x),
+                            _ => {
+                                return Err(self.error(
+                                    &q.loc,
+                                    format!(
+                                        "{}:{}: expected a number, found `{word}`",
+                                        path.display(),
+                                        i + 1
+                                    ),
+                                ))
+                            }
+                        }
+                    }
+                }
+                if numbers.len() % 2 != 0 {
+                    return Err(self.error(
+                        &q.loc,
+                        format!(
+                            "{}: {} numbers: expected (wavelength, value) pairs",
+                            path.display(),
+                            numbers.len()
+                        ),
+                    ));
+                }
+                let pairs: Vec<(f64, f64)> =
+                    numbers.chunks_exact(2).map(|c| (c[0], c[1])).collect();
+                return Spectrum::piecewise(&pairs)
+                    .map_err(|e| self.error(&q.loc, format!("{}: {e}", path.display())));
+            }
             let e = self.error(
                 &q.loc,
-                format!("unknown spectrum `{name}` (spectrum files are not supported)"),
+                format!("unknown spectrum `{name}`: neither a named spectrum nor a readable file"),
             );
             return Err(
                 match did_you_mean(name, plenum_spectrum::names().iter().copied()) {
@@ -2528,7 +2566,7 @@ impl Parser {
                 if reverse {
                     self.warn(loc, "ReverseOrientation on a one-sided sphere light is not supported: it emits outward");
                 }
-                let sphere = Sphere::new(Vec3::ZERO, r);
+                let sphere = Sphere::new(Vec3::ZERO, r).with_uv_map(UvMap::Pbrt);
                 match cut(self, &["zmin", "zmax", "phimax"], partial) {
                     Some(c) => Shape::Sphere(sphere.with_partial(c)),
                     None => Shape::Sphere(sphere),
@@ -2543,7 +2581,7 @@ impl Parser {
                     ..Partial::WHOLE
                 };
                 let n = if reverse { -Vec3::Z } else { Vec3::Z };
-                let disk = Disk::new(Vec3::new(0.0, 0.0, h), n, r);
+                let disk = Disk::new(Vec3::new(0.0, 0.0, h), n, r).with_uv_map(UvMap::Pbrt);
                 match cut(self, &["innerradius", "phimax"], partial) {
                     Some(c) => Shape::Disk(disk.with_partial(c)),
                     None => Shape::Disk(disk),
@@ -2562,7 +2600,7 @@ impl Parser {
                     ..Partial::WHOLE
                 };
                 frame = Transform::translate(Vec3::new(0.0, 0.0, z0));
-                let cylinder = Cylinder::new(r, z1 - z0, false);
+                let cylinder = Cylinder::new(r, z1 - z0, false).with_uv_map(UvMap::Pbrt);
                 match cut(self, &["phimax"], partial) {
                     Some(c) => Shape::Cylinder(cylinder.with_partial(c)),
                     None => Shape::Cylinder(cylinder),

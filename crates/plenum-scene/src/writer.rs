@@ -5,7 +5,7 @@
 
 use crate::RenderDefaults;
 use plenum_core::color::Color;
-use plenum_core::geometry::Shape;
+use plenum_core::geometry::{Shape, UvMap};
 use plenum_core::light::{Attenuation, Emitter, Light};
 use plenum_core::material::{ConductorSpec, FloatTexture, Material, Roughness, SpectralTexture};
 use plenum_core::math::{Transform, Vec3};
@@ -376,11 +376,11 @@ pub fn to_toml(scene: &Scene, defaults: &RenderDefaults) -> String {
             ),
         };
         let _ = match &p.shape {
-            Shape::Sphere(s) => writeln!(w, "type = \"sphere\"\ncenter = {}\nradius = {:?}\ninside_only = {}{}", vec(s.center), s.radius, s.inside_only, partial(s.partial)),
+            Shape::Sphere(s) => writeln!(w, "type = \"sphere\"\ncenter = {}\nradius = {:?}\ninside_only = {}{}{}", vec(s.center), s.radius, s.inside_only, partial(s.partial), uv_map(s.uv_map)),
             Shape::Plane(s) => writeln!(w, "type = \"plane\"\npoint = {}\nnormal = {}", vec(s.point), vec(s.normal)),
-            Shape::Disk(s) => writeln!(w, "type = \"disk\"\ncenter = {}\nnormal = {}\nradius = {:?}{}", vec(s.center), vec(s.normal), s.radius, partial(s.partial)),
+            Shape::Disk(s) => writeln!(w, "type = \"disk\"\ncenter = {}\nnormal = {}\nradius = {:?}{}{}", vec(s.center), vec(s.normal), s.radius, partial(s.partial), uv_map(s.uv_map)),
             Shape::Cuboid(s) => writeln!(w, "type = \"box\"\nmin = {}\nmax = {}", vec(s.min), vec(s.max)),
-            Shape::Cylinder(s) => writeln!(w, "type = \"cylinder\"\nbase = [0.0, 0.0, 0.0]\ntop = [0.0, 0.0, {:?}]\nradius = {:?}\ncapped = {}{}", s.height(), s.radius(), s.is_capped(), partial(s.partial())),
+            Shape::Cylinder(s) => writeln!(w, "type = \"cylinder\"\nbase = [0.0, 0.0, 0.0]\ntop = [0.0, 0.0, {:?}]\nradius = {:?}\ncapped = {}{}{}", s.height(), s.radius(), s.is_capped(), partial(s.partial()), uv_map(s.uv_map())),
             Shape::Cone(s) => writeln!(
                 w,
                 "type = \"cone\"\nbase = [0.0, 0.0, 0.0]\ntop = [0.0, 0.0, {:?}]\nradius = {:?}\ntop_radius = {:?}\ncapped = {}\ninside_only = {}{}",
@@ -636,6 +636,15 @@ fn partial(p: Option<plenum_core::geometry::Partial>) -> String {
 
 fn vec(v: Vec3) -> String {
     format!("[{:?}, {:?}, {:?}]", v.x, v.y, v.z)
+}
+
+/// A quadric's `uv_map` line, where it is not Plenum's own.
+fn uv_map(m: UvMap) -> &'static str {
+    match m {
+        UvMap::Plenum => "",
+        UvMap::Pbrt => "\nuv_map = \"pbrt\"",
+        UvMap::Mitsuba => "\nuv_map = \"mitsuba\"",
+    }
 }
 
 fn color(c: Color) -> String {

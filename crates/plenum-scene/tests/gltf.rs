@@ -826,3 +826,163 @@ fn textures_read_the_texture_coordinate_set_they_name() {
         l.warnings
     );
 }
+
+/// scenes/cornell-box.toml written as glTF: each mesh its own, the walls' materials
+/// diffuse (a coat that reflects nothing: `KHR_materials_specular` with factor 0), the
+/// light a one-sided emissive surface (`doubleSided` false) of the same radiance (factor
+/// times strength), the camera where the native one is.
+fn cornell_box_gltf() -> LoadedScene {
+    let meshes = common::integrators::cornell_meshes();
+    let (mut buffer, mut views, mut accessors, mut gltf_meshes, mut materials, mut nodes) = (
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+        Vec::new(),
+    );
+    for (i, m) in meshes.iter().enumerate() {
+        let start = buffer.len();
+        let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
+        for p in &m.positions {
+            for k in 0..3 {
+                let x = p[k] as f32;
+                buffer.extend(x.to_le_bytes());
+                lo[k] = lo[k].min(x);
+                hi[k] = hi[k].max(x);
+            }
+        }
+        let middle = buffer.len();
+        for t in &m.triangles {
+            for i in t {
+                buffer.extend((*i as u16).to_le_bytes());
+            }
+        }
+        while buffer.len() % 4 != 0 {
+            buffer.push(0);
+        }
+        views.push(format!(
+            r#"{{"buffer": 0, "byteOffset": {start}, "byteLength": {}}}"#,
+            middle - start
+        ));
+        views.push(format!(
+            r#"{{"buffer": 0, "byteOffset": {middle}, "byteLength": {}}}"#,
+            m.triangles.len() * 6
+        ));
+        accessors.push(format!(
+            r#"{{"bufferView": {}, "componentType": 5126, "count": {}, "type": "VEC3", "min": {lo:?}, "max": {hi:?}}}"#,
+            2 * i,
+            m.positions.len()
+        ));
+        accessors.push(format!(
+            r#"{{"bufferView": {}, "componentType": 5123, "count": {}, "type": "SCALAR"}}"#,
+            2 * i + 1,
+            m.triangles.len() * 3
+        ));
+        gltf_meshes.push(format!(
+            r#"{{"primitives": [{{"attributes": {{"POSITION": {}}}, "indices": {}, "material": {i}}}]}}"#,
+            2 * i,
+            2 * i + 1
+        ));
+        let [r, g, b] = m.reflectance;
+        let emission = m.emission.map_or(String::new(), |e| {
+            let strength = e[0].max(e[1]).max(e[2]);
+            format!(
+                r#", "emissiveFactor": [{}, {}, {}], "extensions": {{"KHR_materials_emissive_strength": {{"emissiveStrength": {strength}}}, "KHR_materials_specular": {{"specularFactor": 0}}}}"#,
+                e[0] / strength,
+                e[1] / strength,
+                e[2] / strength
+            )
+        });
+        let specular = match m.emission {
+            None => r#", "extensions": {"KHR_materials_specular": {"specularFactor": 0}}"#,
+            Some(_) => "",
+        };
+        materials.push(format!(
+            r#"{{"name": "{}", "doubleSided": false, "pbrMetallicRoughness": {{"baseColorFactor": [{r}, {g}, {b}, 1], "metallicFactor": 0, "roughnessFactor": 0}}{emission}{specular}}}"#,
+            m.name
+        ));
+        nodes.push(format!(r#"{{"name": "{}", "mesh": {i}}}"#, m.name));
+    }
+    nodes.push(r#"{"camera": 0, "translation": [0, 0, 3.9]}"#.to_string());
+    let roots: Vec<String> = (0..nodes.len()).map(|i| i.to_string()).collect();
+    let text = format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "extensionsUsed": ["KHR_materials_specular", "KHR_materials_emissive_strength"],
+  "scene": 0,
+  "scenes": [{{"nodes": [{}]}}],
+  "nodes": [{}],
+  "meshes": [{}],
+  "materials": [{}],
+  "cameras": [{{"type": "perspective", "perspective": {{"yfov": {}, "aspectRatio": 1, "znear": 0.01}}}}],
+  "buffers": [{{"byteLength": {}, "uri": "data:application/octet-stream;base64,{}"}}],
+  "bufferViews": [{}],
+  "accessors": [{}]
+}}"#,
+        roots.join(", "),
+        nodes.join(", "),
+        gltf_meshes.join(", "),
+        materials.join(", "),
+        39.3077f64.to_radians(),
+        buffer.len(),
+        base64(&buffer),
+        views.join(", "),
+        accessors.join(", ")
+    );
+    let mut l = load(&text);
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    // glTF carries no render settings: the native box's.
+    let native_box = common::integrators::load_cornell_box();
+    let d = &native_box.defaults;
+    (l.defaults.width, l.defaults.height) = (d.width, d.height);
+    (l.defaults.max_depth, l.defaults.rr_depth) = (d.max_depth, d.rr_depth);
+    l
+}
+
+/// The glTF Cornell box: diffuse walls (a coat of index 1 over the base colour), a
+/// one-sided light of the native radiance.
+#[test]
+fn a_cornell_box_in_gltf_reads_as_the_native_one() {
+    let l = cornell_box_gltf();
+    let t = native(&l);
+    let objects = t["objects"].as_array().unwrap();
+    assert_eq!(objects.len(), 8);
+    let light = objects
+        .iter()
+        .find(|o| o.get("emission").is_some())
+        .unwrap();
+    let e: Vec<f64> = light["emission"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(number)
+        .collect();
+    for (got, want) in e.iter().zip([18.387, 13.9873, 6.75357]) {
+        assert!((got - want).abs() < 1e-4, "{e:?}");
+    }
+    assert_eq!(
+        light.get("two_sided").and_then(|v| v.as_bool()),
+        Some(false),
+        "{light:?}"
+    );
+    for o in objects {
+        let m = &t["materials"][o["material"].as_str().unwrap()];
+        assert_eq!(m["type"].as_str(), Some("coateddiffuse"), "{m:?}");
+        assert!((number(&m["eta"]) - 1.0).abs() < 1e-12, "{m:?}");
+    }
+}
+
+#[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
+fn a_cornell_box_in_gltf_matches_mitsubas_render() {
+    common::integrators::cbox_z_test_of(
+        &cornell_box_gltf(),
+        plenum_core::integrator::IntegratorKind::Path,
+        ColorMode::Rgb,
+        "reference.exr",
+        "reference-variance.exr",
+        16,
+        |_| {},
+    );
+}

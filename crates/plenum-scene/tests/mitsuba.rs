@@ -645,3 +645,145 @@ fn a_bitmap_radiance_varies_over_the_emitter() {
         }
     }
 }
+
+#[test]
+fn spheres_disks_and_cylinders_have_mitsubas_uv() {
+    // Mitsuba's (u, v) with v turned up (Plenum's textures have v up the image): a sphere's
+    // u = φ/2π about z from +x, v = 1 − θ/π; a disk's u its radius, v = 1 − φ/2π; a
+    // cylinder's u = φ/2π, v = 1 − z/length.
+    use plenum_core::math::{Ray, Vec3};
+    let textured =
+        r#"<bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf>"#;
+    let l = load(&lit(&format!(
+        r#"<shape type="sphere"><point name="center" x="0" y="0" z="10"/><float name="radius" value="2"/>{textured}</shape>
+<shape type="disk">{textured}</shape>
+<shape type="cylinder"><point name="p0" x="5" y="0" z="0"/><point name="p1" x="5" y="0" z="4"/>{textured}</shape>"#
+    )));
+    let uv = |from: Vec3, to: Vec3| {
+        let ray = Ray::new(from, to - from);
+        let (prim, hit) = l.scene.geometry.intersect(&ray, f64::INFINITY).unwrap();
+        l.scene.geometry.interaction(&ray, prim, &hit).uv
+    };
+    let near = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-9;
+    let v = Vec3::new;
+    // The sphere about (0, 0, 10): +x, and (0, √3, 11) (φ = π/2, θ = π/3).
+    let got = uv(v(5.0, 0.0, 10.0), v(2.0, 0.0, 10.0));
+    assert!(near(got, [0.0, 0.5]), "{got:?}");
+    let got = uv(v(0.0, 5.0, 11.0), v(0.0, 3f64.sqrt(), 11.0));
+    assert!(near(got, [0.25, 2.0 / 3.0]), "{got:?}");
+    // The unit disk in z = 0, seen from above.
+    let got = uv(v(-0.3, 0.4, 1.0), v(-0.3, 0.4, 0.0));
+    let phi = 0.4f64.atan2(-0.3);
+    assert!(
+        near(got, [0.5, 1.0 - phi / (2.0 * std::f64::consts::PI)]),
+        "{got:?}"
+    );
+    // The cylinder from (5, 0, 0) up to (5, 0, 4): its frame's x is +x, so (4, 0, 1) is
+    // φ = π, a quarter of the way up.
+    let got = uv(v(3.0, 0.0, 1.0), v(4.0, 0.0, 1.0));
+    assert!(near(got, [0.5, 0.75]), "{got:?}");
+}
+
+/// scenes/cornell-box.toml written as Mitsuba 3 XML (each mesh an OBJ file shaded flat, as
+/// the boxes share their corners between faces; Mitsuba's one-sided diffuse, a one-sided
+/// area light, the path tracer's max_depth 8): the scene and its files.
+fn cornell_box_xml() -> Vec<(String, Vec<u8>)> {
+    let mut files = Vec::new();
+    let mut shapes = String::new();
+    for m in common::integrators::cornell_meshes() {
+        let mut obj = String::new();
+        for p in &m.positions {
+            obj += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+        }
+        for t in &m.triangles {
+            obj += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+        }
+        let [r, g, b] = m.reflectance;
+        let emitter = m.emission.map_or(String::new(), |[r, g, b]| {
+            format!(
+                r#"<emitter type="area"><rgb name="radiance" value="{r}, {g}, {b}"/></emitter>"#
+            )
+        });
+        shapes += &format!(
+            r#"<shape type="obj"><string name="filename" value="{0}.obj"/><boolean name="face_normals" value="true"/><bsdf type="diffuse"><rgb name="reflectance" value="{r}, {g}, {b}"/></bsdf>{emitter}</shape>
+"#,
+            m.name
+        );
+        files.push((format!("{}.obj", m.name), obj.into_bytes()));
+    }
+    let scene = format!(
+        r#"<scene version="3.0.0">
+<integrator type="path"><integer name="max_depth" value="8"/></integrator>
+<sensor type="perspective">
+  <float name="fov" value="39.3077"/>
+  <transform name="to_world"><lookat origin="0, 0, 3.9" target="0, 0, 2.9" up="0, 1, 0"/></transform>
+  <sampler type="independent"><integer name="sample_count" value="64"/></sampler>
+  <film type="hdrfilm"><integer name="width" value="256"/><integer name="height" value="256"/><rfilter type="box"/></film>
+</sensor>
+{shapes}</scene>
+"#
+    );
+    files.insert(0, ("scene.xml".to_string(), scene.into_bytes()));
+    files
+}
+
+fn cornell_box() -> LoadedScene {
+    let files = cornell_box_xml();
+    let refs: Vec<(&str, &[u8])> = files.iter().map(|(n, b)| (n.as_str(), &b[..])).collect();
+    load_files(&refs).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The Cornell box in Mitsuba's XML reads as scenes/cornell-box.toml: the same settings
+/// (max_depth 8 is Plenum's 6), camera, reflectances and light, without a warning.
+#[test]
+fn a_cornell_box_in_mitsubas_format_reads_as_the_native_one() {
+    let l = cornell_box();
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    let native_box = common::integrators::load_cornell_box();
+    let (d, e) = (&l.defaults, &native_box.defaults);
+    assert_eq!(
+        (d.spp, d.max_depth, d.filter, d.width, d.height),
+        (e.spp, e.max_depth, e.filter, e.width, e.height)
+    );
+    let (a, b) = (native(&l), native(&native_box));
+    for key in ["position", "look_at", "fov"] {
+        let (x, y) = (&a["camera"][key], &b["camera"][key]);
+        let flat = |v: &Value| match v.as_array() {
+            Some(a) => a.iter().map(number).collect::<Vec<f64>>(),
+            None => vec![number(v)],
+        };
+        let (x, y) = (flat(x), flat(y));
+        assert!(
+            x.iter().zip(&y).all(|(p, q)| (p - q).abs() < 1e-9),
+            "{key}: {x:?} {y:?}"
+        );
+    }
+    let objects = |t: &Table| t["objects"].as_array().unwrap().len();
+    assert_eq!(objects(&a), objects(&b));
+    let emitters = |t: &Table| {
+        t["objects"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|o| {
+                o.get("emission")
+                    .map(|e| e.as_array().unwrap().iter().map(number).collect::<Vec<_>>())
+            })
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(emitters(&a), emitters(&b));
+}
+
+#[test]
+#[ignore = "full suite (cargo test -- --include-ignored): over 10 s"]
+fn a_cornell_box_in_mitsubas_format_matches_mitsubas_render() {
+    common::integrators::cbox_z_test_of(
+        &cornell_box(),
+        plenum_core::integrator::IntegratorKind::Path,
+        ColorMode::Rgb,
+        "reference.exr",
+        "reference-variance.exr",
+        16,
+        |_| {},
+    );
+}

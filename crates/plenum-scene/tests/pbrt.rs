@@ -1336,3 +1336,100 @@ fn options_are_read_and_what_plenum_lacks_is_warned() {
     let e = error(&scene("Option \"seed\"")).to_string();
     assert!(e.contains("needs a value"), "{e}");
 }
+
+#[test]
+fn spheres_disks_and_cylinders_have_pbrts_uv() {
+    // pbrt-v4's (u, v): u = φ/φ_max about z from +x; v up a sphere's θ between its cut
+    // heights, in from a disk's rim to its inner radius, up a cylinder's height. A texture
+    // asks for uv at the hits.
+    use plenum_core::math::{Ray, Vec3};
+    let l = load(
+        r#"WorldBegin
+LightSource "point"
+Texture "t" "spectrum" "checkerboard"
+Material "diffuse" "texture reflectance" "t"
+AttributeBegin
+  Translate 0 0 10
+  Shape "sphere" "float radius" 2 "float zmin" -1 "float zmax" 1.5 "float phimax" 270
+AttributeEnd
+Shape "disk" "float radius" 2 "float innerradius" 1
+AttributeBegin
+  Translate 6 0 0
+  Shape "cylinder" "float radius" 1 "float zmin" -1 "float zmax" 3 "float phimax" 180
+AttributeEnd
+"#,
+    );
+    let uv = |from: Vec3, to: Vec3| {
+        let ray = Ray::new(from, to - from);
+        let (prim, hit) = l.scene.geometry.intersect(&ray, f64::INFINITY).unwrap();
+        l.scene.geometry.interaction(&ray, prim, &hit).uv
+    };
+    let near = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-9;
+    let v = Vec3::new;
+    let theta = |z: f64| (z / 2.0f64).acos();
+    let (t0, t1) = (theta(-1.0), theta(1.5));
+    // The band of the sphere about (0, 0, 10): (0, 2, 10) is φ = π/2 of 3π/2, θ = π/2.
+    let got = uv(v(0.0, 5.0, 10.0), v(0.0, 2.0, 10.0));
+    assert!(
+        near(
+            got,
+            [1.0 / 3.0, (t0 - 0.5 * std::f64::consts::PI) / (t0 - t1)]
+        ),
+        "{got:?}"
+    );
+    // The ring: (0, −1.5, 0) is φ = 3π/2, halfway in.
+    let got = uv(v(0.0, -1.5, 1.0), v(0.0, -1.5, 0.0));
+    assert!(near(got, [0.75, 0.5]), "{got:?}");
+    // The half cylinder about x = 6 from z = −1 to 3: (6, 1, 0) is φ = π/2 of π, a quarter up.
+    let got = uv(v(6.0, 3.0, 0.0), v(6.0, 1.0, 0.0));
+    assert!(near(got, [0.5, 0.25]), "{got:?}");
+    // `plenum convert` keeps the maps.
+    let written = plenum_scene::to_toml(&l.scene, &l.defaults);
+    assert_eq!(written.matches("uv_map = \"pbrt\"").count(), 3, "{written}");
+}
+
+#[test]
+fn spectrum_files_are_read_beside_the_scene() {
+    use plenum_core::material::Material;
+    use plenum_core::math::Vec3;
+    use plenum_core::texture::TextureCoords;
+    let scene = |file: &str| {
+        format!("WorldBegin\nLightSource \"point\"\nMaterial \"diffuse\" \"spectrum reflectance\" \"{file}\"\nShape \"sphere\"\n")
+    };
+    // A flat 0.5 over the visible range, with comments and pairs split across lines.
+    let flat = "# a grey\n360 0.5\n830\n0.5 # the end\n";
+    let l = load_files(&[
+        ("scene.pbrt", scene("grey.spd").as_bytes()),
+        ("grey.spd", flat.as_bytes()),
+    ])
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    let Material::Diffuse(d) = &l.scene.materials[l.scene.geometry.primitives[0].material as usize]
+    else {
+        panic!("expected a diffuse material")
+    };
+    let c = d.reflectance.rgb(&TextureCoords::new([0.0; 2], Vec3::ZERO));
+    assert!(
+        [c.r, c.g, c.b].iter().all(|x| (x - 0.5).abs() < 0.01),
+        "{c:?}"
+    );
+    // An odd count and a word that is not a number are errors naming the file and line.
+    let odd = load_files(&[
+        ("scene.pbrt", scene("odd.spd").as_bytes()),
+        ("odd.spd", b"400 0.5 700"),
+    ]);
+    let e = odd.err().expect("an error").to_string();
+    assert!(
+        e.contains("scene.pbrt:3:") && e.contains("3 numbers"),
+        "{e}"
+    );
+    let bad = load_files(&[
+        ("scene.pbrt", scene("bad.spd").as_bytes()),
+        ("bad.spd", b"400 0.5\n700 half\n"),
+    ]);
+    let e = bad.err().expect("an error").to_string();
+    assert!(e.contains("bad.spd:2") && e.contains("`half`"), "{e}");
+    // Neither a name nor a file.
+    let e = error(&scene("metal-Au-etta")).to_string();
+    assert!(e.contains("did you mean `metal-Au-eta`"), "{e}");
+}

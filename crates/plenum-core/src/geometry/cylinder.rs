@@ -1,12 +1,16 @@
 //! Finite circular cylinders about the z axis from z = 0 to z = height, optionally capped:
 //! a cone whose two radii are equal.
 
-use super::{Cone, HitRecord, Partial, SurfaceGeometry};
+use super::{Cone, HitRecord, Partial, SurfaceGeometry, UvMap};
 use crate::math::{Bounds3, Ray, Vec3};
+use std::f64::consts::TAU;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cylinder {
     shape: Cone,
+    /// Whose (u, v) its side reports: Plenum's (φ/2π about z from +x, z/height) is
+    /// pbrt-v4's for a whole turn; pbrt-v4 divides φ by φ_max, Mitsuba turns v down.
+    uv_map: UvMap,
 }
 
 impl Cylinder {
@@ -20,6 +24,24 @@ impl Cylinder {
                 inside_only: false,
                 partial: None,
             },
+            uv_map: UvMap::Plenum,
+        }
+    }
+
+    /// The cylinder reporting `map`'s (u, v).
+    pub fn with_uv_map(self, uv_map: UvMap) -> Self {
+        Cylinder { uv_map, ..self }
+    }
+
+    /// What multiplies Plenum's u and v for the map (v: 1 − v where negative).
+    fn uv_scale(&self) -> (f64, f64) {
+        match self.uv_map {
+            UvMap::Plenum => (1.0, 1.0),
+            UvMap::Pbrt => (
+                TAU / self.shape.partial.map_or(TAU, |p| p.phi_max.min(TAU)),
+                1.0,
+            ),
+            UvMap::Mitsuba => (1.0, -1.0),
         }
     }
 
@@ -35,6 +57,10 @@ impl Cylinder {
 
     pub fn radius(&self) -> f64 {
         self.shape.radius0
+    }
+
+    pub fn uv_map(&self) -> UvMap {
+        self.uv_map
     }
 
     pub fn is_capped(&self) -> bool {
@@ -54,11 +80,18 @@ impl Cylinder {
     }
 
     pub fn surface(&self, ray: &Ray, hit: &HitRecord, want_uv: bool) -> SurfaceGeometry {
-        self.shape.surface(ray, hit, want_uv)
+        let mut g = self.shape.surface(ray, hit, want_uv);
+        if want_uv && self.uv_map != UvMap::Plenum {
+            let (su, sv) = self.uv_scale();
+            g.uv = [g.uv[0] * su, if sv < 0.0 { 1.0 - g.uv[1] } else { g.uv[1] }];
+        }
+        g
     }
 
     pub fn uv_derivatives(&self, hit: &HitRecord, p: Vec3) -> [Vec3; 2] {
-        self.shape.uv_derivatives(hit, p)
+        let [dpdu, dpdv] = self.shape.uv_derivatives(hit, p);
+        let (su, sv) = self.uv_scale();
+        [dpdu / su, dpdv * sv]
     }
 }
 

@@ -1,8 +1,8 @@
 //! A flat disk: the points of a plane within `radius` of `center`.
 
-use super::{plane_distance, project_onto_plane, HitRecord, Partial, SurfaceGeometry};
+use super::{plane_distance, project_onto_plane, HitRecord, Partial, SurfaceGeometry, UvMap};
 use crate::math::{Bounds3, Ray, Vec3};
-use std::f64::consts::PI;
+use std::f64::consts::{PI, TAU};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Disk {
@@ -15,6 +15,8 @@ pub struct Disk {
     /// What is kept of it, in the scene's axes about `center` (pbrt-v4's disks lie in the
     /// xy plane): a hole, a sector. None: all.
     pub partial: Option<Partial>,
+    /// Whose (u, v) it reports (pbrt-v4's and Mitsuba's measure angles in the xy plane).
+    pub uv_map: UvMap,
 }
 
 impl Disk {
@@ -28,7 +30,19 @@ impl Disk {
             tangent_s,
             tangent_t,
             partial: None,
+            uv_map: UvMap::Plenum,
         }
+    }
+
+    /// The disk reporting `map`'s (u, v).
+    pub fn with_uv_map(self, uv_map: UvMap) -> Self {
+        Disk { uv_map, ..self }
+    }
+
+    /// φ_max and the inner radius pbrt-v4 maps (u, v) over.
+    fn extent(&self) -> (f64, f64) {
+        let p = self.partial.unwrap_or(Partial::WHOLE);
+        (p.phi_max.min(TAU), p.inner_radius.clamp(0.0, self.radius))
     }
 
     /// The disk cut to what `partial` keeps.
@@ -67,13 +81,36 @@ impl Disk {
         let (p, p_error) =
             project_onto_plane(ray, hit.t, self.normal, self.normal.dot(self.center));
         let d = p - self.center;
-        let (x, y) = (d.dot(self.tangent_s), d.dot(self.tangent_t));
-        let uv = if want_uv {
+        let angle = |x: f64, y: f64| {
             let phi = y.atan2(x);
-            let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
-            [phi / (2.0 * PI), (x * x + y * y).sqrt() / self.radius]
-        } else {
-            [0.0, 0.0]
+            if phi < 0.0 {
+                phi + 2.0 * PI
+            } else {
+                phi
+            }
+        };
+        let uv = match (want_uv, self.uv_map) {
+            (false, _) => [0.0, 0.0],
+            (true, UvMap::Plenum) => {
+                let (x, y) = (d.dot(self.tangent_s), d.dot(self.tangent_t));
+                [
+                    angle(x, y) / (2.0 * PI),
+                    (x * x + y * y).sqrt() / self.radius,
+                ]
+            }
+            (true, UvMap::Pbrt) => {
+                let (phi_max, inner) = self.extent();
+                let rho = (d.x * d.x + d.y * d.y).sqrt();
+                let v = match self.radius - inner {
+                    w if w > 0.0 => (self.radius - rho) / w,
+                    _ => 0.0,
+                };
+                [angle(d.x, d.y) / phi_max, v]
+            }
+            (true, UvMap::Mitsuba) => [
+                (d.x * d.x + d.y * d.y).sqrt() / self.radius,
+                1.0 - angle(d.x, d.y) / (2.0 * PI),
+            ],
         };
         SurfaceGeometry::flat(p, p_error, self.normal, uv)
     }
@@ -82,6 +119,22 @@ impl Disk {
     /// at the centre.
     pub fn uv_derivatives(&self, p: Vec3) -> [Vec3; 2] {
         let d = p - self.center;
+        if self.uv_map != UvMap::Plenum {
+            let rho = (d.x * d.x + d.y * d.y).sqrt();
+            let around = Vec3::new(-d.y, d.x, 0.0);
+            let outward = if rho > 0.0 {
+                Vec3::new(d.x, d.y, 0.0) / rho
+            } else {
+                Vec3::X
+            };
+            return match self.uv_map {
+                UvMap::Mitsuba => [outward * self.radius, around * (-2.0 * PI)],
+                _ => {
+                    let (phi_max, inner) = self.extent();
+                    [around * phi_max, outward * -(self.radius - inner)]
+                }
+            };
+        }
         let (x, y) = (d.dot(self.tangent_s), d.dot(self.tangent_t));
         let rho = (x * x + y * y).sqrt();
         let around = (self.tangent_t * x - self.tangent_s * y) * (2.0 * PI);

@@ -48,6 +48,22 @@ pub struct HitRecord {
     pub part: u32,
 }
 
+/// Whose (u, v) a sphere, disk or cylinder reports. The formats Plenum reads lay these
+/// shapes about z and map them each their own way, and a texture lands where its file says
+/// only under that map. (Every map here has v up the image, as Plenum's textures.)
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum UvMap {
+    /// Plenum's own: a sphere's poles on y; see docs/scene-format.md.
+    #[default]
+    Plenum,
+    /// pbrt-v4's: u = φ/φ_max about z from +x toward +y; v up a sphere's θ between its cut
+    /// heights, in from a disk's rim to its inner radius, up a cylinder's height.
+    Pbrt,
+    /// Mitsuba 3's, its v turned up: a sphere's as pbrt's; a disk's u its radius and v
+    /// 1 − φ/2π; a cylinder's v 1 − height/length.
+    Mitsuba,
+}
+
 /// The local geometry at a hit, in the shape's coordinates.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceGeometry {
@@ -257,5 +273,155 @@ pub(crate) mod test_util {
 
     pub fn assert_close(a: Vec3, b: Vec3, tol: f64) {
         assert!((a - b).length() <= tol, "{a:?} != {b:?} (tolerance {tol})");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    /// A shape and the ∂p/∂u, ∂p/∂v it gives at a point of it.
+    type Derivatives = Box<dyn Fn(Vec3) -> [Vec3; 2]>;
+
+    /// pbrt-v4's and Mitsuba's (u, v) on spheres, disks and cylinders at points whose
+    /// (u, v) their definitions give by hand, and ∂p/∂u, ∂p/∂v that move (u, v) by what
+    /// they say.
+    #[test]
+    fn each_uv_map_places_known_points_and_its_derivatives_follow_it() {
+        let v = Vec3::new;
+        let pbrt_band = Partial {
+            z_min: -1.0,
+            z_max: 1.0,
+            phi_max: PI,
+            ..Partial::WHOLE
+        };
+        let ring = Partial {
+            inner_radius: 1.0,
+            phi_max: PI,
+            ..Partial::WHOLE
+        };
+        let sector = Partial {
+            phi_max: PI,
+            ..Partial::WHOLE
+        };
+        let pbrt_sphere = Sphere::new(Vec3::ZERO, 2.0).with_uv_map(UvMap::Pbrt);
+        let band = pbrt_sphere.with_partial(pbrt_band);
+        let mitsuba_sphere = Sphere::new(v(1.0, 0.0, 0.0), 2.0).with_uv_map(UvMap::Mitsuba);
+        let pbrt_disk = Disk::new(Vec3::ZERO, Vec3::Z, 2.0)
+            .with_uv_map(UvMap::Pbrt)
+            .with_partial(ring);
+        let reversed_disk = Disk::new(Vec3::ZERO, -Vec3::Z, 2.0).with_uv_map(UvMap::Pbrt);
+        let mitsuba_disk = Disk::new(Vec3::ZERO, Vec3::Z, 1.0).with_uv_map(UvMap::Mitsuba);
+        let pbrt_cylinder = Cylinder::new(1.0, 2.0, false)
+            .with_uv_map(UvMap::Pbrt)
+            .with_partial(sector);
+        let mitsuba_cylinder = Cylinder::new(1.0, 2.0, false).with_uv_map(UvMap::Mitsuba);
+        let side = HitRecord {
+            t: 0.0,
+            u: 0.0,
+            v: 0.0,
+            part: 0,
+        };
+        let theta = |z: f64| (z / 2.0_f64).acos();
+        // (shape, its derivatives, [(point, (u, v))]).
+        let cases: Vec<(Shape, Derivatives, Vec<(Vec3, [f64; 2])>)> = vec![
+            (
+                Shape::Sphere(pbrt_sphere),
+                Box::new(move |p| pbrt_sphere.uv_derivatives(p)),
+                vec![
+                    (v(2.0, 0.0, 0.0), [0.0, 0.5]),
+                    (v(0.0, 2.0, 0.0), [0.25, 0.5]),
+                    (v(-2.0, 0.0, 0.0), [0.5, 0.5]),
+                    (
+                        v(0.0, -1.0, 3f64.sqrt()),
+                        [0.75, 1.0 - theta(3f64.sqrt()) / PI],
+                    ),
+                ],
+            ),
+            (
+                Shape::Sphere(band),
+                Box::new(move |p| band.uv_derivatives(p)),
+                // θ runs from 2π/3 (z = −1) up to π/3 (z = 1); φ over π.
+                vec![
+                    (v(0.0, 2.0, 0.0), [0.5, 0.5]),
+                    (v(3f64.sqrt(), 0.0, 1.0), [0.0, 1.0]),
+                ],
+            ),
+            (
+                Shape::Sphere(mitsuba_sphere),
+                Box::new(move |p| mitsuba_sphere.uv_derivatives(p)),
+                // About its centre; θ = 2π/3 is v = ⅓.
+                vec![
+                    (v(1.0, 2.0, 0.0), [0.25, 0.5]),
+                    (v(1.0 + 3f64.sqrt(), 0.0, -1.0), [0.0, 1.0 / 3.0]),
+                ],
+            ),
+            (
+                Shape::Disk(pbrt_disk),
+                Box::new(move |p| pbrt_disk.uv_derivatives(p)),
+                // v from the rim (0) in to the inner radius (1).
+                vec![
+                    (v(1.5, 0.0, 0.0), [0.0, 0.5]),
+                    (v(0.0, 1.2, 0.0), [0.5, 0.8]),
+                ],
+            ),
+            (
+                Shape::Disk(reversed_disk),
+                Box::new(move |p| reversed_disk.uv_derivatives(p)),
+                // The angle is about +z whichever way the disk faces.
+                vec![(v(0.0, 1.0, 0.0), [0.25, 0.5])],
+            ),
+            (
+                Shape::Disk(mitsuba_disk),
+                Box::new(move |p| mitsuba_disk.uv_derivatives(p)),
+                vec![
+                    (v(0.0, 0.5, 0.0), [0.5, 0.75]),
+                    (
+                        v(-0.3, 0.4, 0.0),
+                        [0.5, 1.0 - 0.4f64.atan2(-0.3) / (2.0 * PI)],
+                    ),
+                ],
+            ),
+            (
+                Shape::Cylinder(pbrt_cylinder),
+                Box::new(move |p| pbrt_cylinder.uv_derivatives(&side, p)),
+                vec![
+                    (v(0.0, 1.0, 1.0), [0.5, 0.5]),
+                    (v(1.0, 0.0, 0.5), [0.0, 0.25]),
+                ],
+            ),
+            (
+                Shape::Cylinder(mitsuba_cylinder),
+                Box::new(move |p| mitsuba_cylinder.uv_derivatives(&side, p)),
+                vec![
+                    (v(1.0, 0.0, 0.5), [0.0, 0.75]),
+                    (v(0.0, -1.0, 1.0), [0.75, 0.5]),
+                ],
+            ),
+        ];
+        for (shape, derivatives, points) in cases {
+            for (p, want) in points {
+                let got = shape.uv_at(p, 0);
+                assert!(
+                    (got[0] - want[0]).abs() < 1e-12 && (got[1] - want[1]).abs() < 1e-12,
+                    "{shape:?} at {p:?}: {got:?}, expected {want:?}"
+                );
+                // Along ∂p/∂u (∂p/∂v), u (v) moves by the step and the other not.
+                let [dpdu, dpdv] = derivatives(p);
+                let e = 1e-6;
+                for (k, d) in [dpdu, dpdv].into_iter().enumerate() {
+                    let moved = shape.uv_at(p + d * e, 0);
+                    let du = [(moved[0] - got[0]) / e, (moved[1] - got[1]) / e];
+                    let mut expected = [0.0, 0.0];
+                    expected[k] = 1.0;
+                    assert!(
+                        (du[0] - expected[0]).abs() < 1e-4 && (du[1] - expected[1]).abs() < 1e-4,
+                        "{shape:?} at {p:?}: ∂(u, v) along ∂p/∂{} is {du:?}",
+                        ["u", "v"][k]
+                    );
+                }
+            }
+        }
     }
 }

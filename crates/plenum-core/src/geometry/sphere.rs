@@ -2,9 +2,9 @@
 //! for ray/sphere intersection" (Ray Tracing Gems, ch. 7): the discriminant is computed from
 //! the ray's perpendicular offset to the centre, which stays accurate for far or huge spheres.
 
-use super::{nearest_root, HitRecord, Partial, SurfaceGeometry};
+use super::{nearest_root, HitRecord, Partial, SurfaceGeometry, UvMap};
 use crate::math::{gamma, Bounds3, Ray, Vec3};
-use std::f64::consts::PI;
+use std::f64::consts::{PI, TAU};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sphere {
@@ -14,6 +14,8 @@ pub struct Sphere {
     pub inside_only: bool,
     /// What is kept of it, about `center` (none: all).
     pub partial: Option<Partial>,
+    /// Whose (u, v) it reports.
+    pub uv_map: UvMap,
 }
 
 impl Sphere {
@@ -23,7 +25,20 @@ impl Sphere {
             radius,
             inside_only: false,
             partial: None,
+            uv_map: UvMap::Plenum,
         }
+    }
+
+    /// The sphere reporting `map`'s (u, v).
+    pub fn with_uv_map(self, uv_map: UvMap) -> Self {
+        Sphere { uv_map, ..self }
+    }
+
+    /// pbrt-v4's φ_max and the polar angles θ (from +z) at the bottom and top cuts.
+    fn z_up_extent(&self) -> (f64, f64, f64) {
+        let p = self.partial.unwrap_or(Partial::WHOLE);
+        let theta = |z: f64| (z / self.radius).clamp(-1.0, 1.0).acos();
+        (p.phi_max.min(TAU), theta(p.z_min), theta(p.z_max))
     }
 
     /// The sphere cut to what `partial` keeps.
@@ -95,13 +110,22 @@ impl Sphere {
         let p = self.center + offset;
         let p_error = (offset.abs() + self.center.abs()) * gamma(8);
         let n = offset / self.radius;
-        // Poles on the y axis, the scene's up: u runs around it, v from the top (0) down.
-        let uv = if want_uv {
-            let phi = n.x.atan2(n.z);
-            let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
-            [phi / (2.0 * PI), n.y.clamp(-1.0, 1.0).acos() / PI]
-        } else {
-            [0.0, 0.0]
+        let uv = match (want_uv, self.uv_map) {
+            (false, _) => [0.0, 0.0],
+            // Poles on the y axis, the scene's up: u runs around it, v from the top (0) down.
+            (true, UvMap::Plenum) => {
+                let phi = n.x.atan2(n.z);
+                let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
+                [phi / (2.0 * PI), n.y.clamp(-1.0, 1.0).acos() / PI]
+            }
+            // Poles on z: u around from +x toward +y, v up from the bottom cut to the top.
+            (true, UvMap::Pbrt | UvMap::Mitsuba) => {
+                let (phi_max, theta_min, theta_max) = self.z_up_extent();
+                let phi = n.y.atan2(n.x);
+                let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
+                let theta = n.z.clamp(-1.0, 1.0).acos();
+                [phi / phi_max, (theta_min - theta) / (theta_min - theta_max)]
+            }
         };
         SurfaceGeometry::flat(p, p_error, n, uv)
     }
@@ -110,6 +134,18 @@ impl Sphere {
     /// cos θ, sin θ cos φ) with φ = 2πu and θ = πv. Zero at the poles.
     pub fn uv_derivatives(&self, p: Vec3) -> [Vec3; 2] {
         let o = p - self.center;
+        if self.uv_map != UvMap::Plenum {
+            // p = c + (ρ cos φ, ρ sin φ, r cos θ), φ = φ_max·u, θ = θ₀ − (θ₀ − θ₁)·v.
+            let (phi_max, theta_min, theta_max) = self.z_up_extent();
+            let rho = (o.x * o.x + o.y * o.y).sqrt();
+            let dpdu = Vec3::new(-o.y, o.x, 0.0) * phi_max;
+            let dpdv = if rho > 0.0 {
+                Vec3::new(-o.z * o.x / rho, -o.z * o.y / rho, rho) * (theta_min - theta_max)
+            } else {
+                Vec3::ZERO
+            };
+            return [dpdu, dpdv];
+        }
         // ρ = r sin θ, the distance from the axis.
         let rho = (o.x * o.x + o.z * o.z).sqrt();
         let dpdu = Vec3::new(o.z, 0.0, -o.x) * (2.0 * PI);

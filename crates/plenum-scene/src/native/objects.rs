@@ -8,6 +8,7 @@ use crate::{obj, ply};
 use plenum_core::color::Color;
 use plenum_core::geometry::{
     Cone, Cuboid, Cylinder, Disk, Partial, Plane, Polygon, Polyhedron, Shape, Sphere, TriangleMesh,
+    UvMap,
 };
 use plenum_core::material::PhongMaterial;
 use plenum_core::math::{Transform, Vec3};
@@ -37,11 +38,19 @@ impl<'s> Reader<'s> {
                 "z_min",
                 "z_max",
                 "phi_max",
+                "uv_map",
             ],
             "plane" => &["point", "normal"],
-            "disk" => &["center", "normal", "radius", "inner_radius", "phi_max"],
+            "disk" => &[
+                "center",
+                "normal",
+                "radius",
+                "inner_radius",
+                "phi_max",
+                "uv_map",
+            ],
             "box" => &["min", "max"],
-            "cylinder" => &["base", "top", "radius", "capped", "phi_max"],
+            "cylinder" => &["base", "top", "radius", "capped", "phi_max", "uv_map"],
             "cone" => &[
                 "base",
                 "top",
@@ -257,12 +266,27 @@ impl<'s> Reader<'s> {
                 degrees.to_radians()
             })
         };
+        // Whose (u, v) a sphere, disk or cylinder reports.
+        let uv_map = match f.get("uv_map") {
+            None => UvMap::Plenum,
+            Some(v) => match src.string(v)? {
+                "plenum" => UvMap::Plenum,
+                "pbrt" => UvMap::Pbrt,
+                "mitsuba" => UvMap::Mitsuba,
+                other => {
+                    return Err(src
+                        .error(v.span(), format!("unknown uv_map `{other}`"))
+                        .with_help("expected \"plenum\", \"pbrt\" or \"mitsuba\""))
+                }
+            },
+        };
         let shape = match kind {
             "sphere" => {
                 let mut sphere = Sphere::new(
                     f.vec3_or("center", Vec3::ZERO)?,
                     f.positive("radius", None)?,
-                );
+                )
+                .with_uv_map(uv_map);
                 sphere.inside_only = f.bool_or("inside_only", false)?;
                 let (z_min, z_max) = (
                     f.number_or("z_min", f64::NEG_INFINITY)?,
@@ -298,7 +322,8 @@ impl<'s> Reader<'s> {
                     f.vec3_or("center", Vec3::ZERO)?,
                     f.direction("normal", None)?,
                     radius,
-                );
+                )
+                .with_uv_map(uv_map);
                 Shape::Disk(disk.with_partial(Partial {
                     inner_radius,
                     phi_max: phi_max(f)?,
@@ -338,7 +363,8 @@ impl<'s> Reader<'s> {
                     ..Partial::WHOLE
                 };
                 let shape = if kind == "cylinder" {
-                    Shape::Cylinder(Cylinder::new(radius, height, capped).with_partial(sector))
+                    let cylinder = Cylinder::new(radius, height, capped).with_uv_map(uv_map);
+                    Shape::Cylinder(cylinder.with_partial(sector))
                 } else {
                     let top_radius = f.number_or("top_radius", 0.0)?;
                     if top_radius < 0.0 {

@@ -231,6 +231,26 @@ pub fn cbox_z_test_of(
         (0.8..=1.25).contains(&ratio),
         "squared error is {ratio} × what noise predicts"
     );
+    // The image mean within 4σ of the reference's, per channel, σ from both images'
+    // per-pixel variances (pixels independent): a pass rate cannot see a small bias spread
+    // over the whole image.
+    let n = mean.len() as f64;
+    for c in 0..3 {
+        let ours = mean.iter().map(|p| p[c]).sum::<f64>() / n;
+        let theirs = reference.iter().map(|p| p[c] as f64).sum::<f64>() / n;
+        let variance = (var.iter().map(|p| p[c]).sum::<f64>()
+            + ref_var.iter().map(|p| p[c] as f64).sum::<f64>())
+            / (n * n);
+        let z = (ours - theirs) / variance.sqrt();
+        eprintln!(
+            "  channel {c}: mean {ours:.5} against {theirs:.5} ({:+.3} %, z = {z:+.2})",
+            100.0 * (ours / theirs - 1.0)
+        );
+        assert!(
+            z.abs() <= 4.0,
+            "channel {c}: the image mean is {z:.2} σ off"
+        );
+    }
 }
 
 /// Each pixel channel's mean over independent `images` and the variance of that mean.
@@ -320,4 +340,50 @@ pub fn normal_quantile(p: f64) -> f64 {
 pub fn load_cornell_box() -> LoadedScene {
     let file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
     load_scene(&file).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A mesh of scenes/cornell-box.toml: its corners, triangles, reflectance and emission.
+pub struct CornellMesh {
+    pub name: String,
+    pub positions: Vec<[f64; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    pub reflectance: [f64; 3],
+    pub emission: Option<[f64; 3]>,
+}
+
+/// The meshes of scenes/cornell-box.toml, read from the file as written: what the tests
+/// write the box in other formats from.
+pub fn cornell_meshes() -> Vec<CornellMesh> {
+    let file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
+    let t: toml::Table = std::fs::read_to_string(file).unwrap().parse().unwrap();
+    let num = |v: &toml::Value| {
+        v.as_float()
+            .unwrap_or_else(|| v.as_integer().unwrap() as f64)
+    };
+    let three = |v: &toml::Value| {
+        let a = v.as_array().unwrap();
+        [num(&a[0]), num(&a[1]), num(&a[2])]
+    };
+    t["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| CornellMesh {
+            name: o["name"].as_str().unwrap().to_string(),
+            positions: o["positions"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(three)
+                .collect(),
+            triangles: o["indices"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|i| three(i).map(|x| x as u32))
+                .collect(),
+            reflectance: three(&t["materials"][o["material"].as_str().unwrap()]["reflectance"]),
+            emission: o.get("emission").map(three),
+        })
+        .collect()
 }
