@@ -572,3 +572,105 @@ material = "m"
         "{e}"
     );
 }
+
+/// The noise, dots, directionmix and mapped textures and a quadric's `uv_map` in the native
+/// format; what they take wrongly is a located error.
+#[test]
+fn mapped_and_procedural_textures_in_the_native_format() {
+    use plenum_core::material::Material;
+    use plenum_core::texture::{noise, TextureCoords};
+    let scene = |diffuse: &str, extra: &str| {
+        format!(
+            "[materials.m]\ndiffuse = {diffuse}\n[[objects]]\ntype = \"sphere\"\nradius = 1\nmaterial = \"m\"\n{extra}"
+        )
+    };
+    let diffuse = |text: &str| {
+        let l = parse_scene(Path::new("scene.toml"), text, Path::new("."))
+            .unwrap_or_else(|e| panic!("{e}"));
+        let Material::Phong(p) =
+            &l.scene.materials[l.scene.geometry.primitives[0].material as usize]
+        else {
+            panic!("expected a Phong material");
+        };
+        (p.diffuse.clone(), l)
+    };
+    // (u, v) scaled by 2 and moved by ½ along u: (0.1, 0.1) is (0.7, 0.2), an even square;
+    // (0.3, 0.1) is (1.1, 0.2), an odd one (unmapped, both would be even).
+    let (t, _) = diffuse(&scene(
+        r#"{ texture = "mapped", mapping = "uv", scale = [2, 2], delta = [0.5, 0], of = { texture = "checker" } }"#,
+        "",
+    ));
+    assert_eq!(
+        t.evaluate(&TextureCoords::new([0.1, 0.1], Vec3::ZERO)),
+        Color::WHITE
+    );
+    assert_eq!(
+        t.evaluate(&TextureCoords::new([0.3, 0.1], Vec3::ZERO)),
+        Color::BLACK
+    );
+    // fBm in a space moved by (0, 0, 3): looked up at p − (0, 0, 3).
+    let (t, _) = diffuse(&scene(
+        r#"{ texture = "mapped", mapping = "solid", transform = { translate = [0, 0, 3] }, of = { texture = "fbm", omega = 0.6, octaves = 3 } }"#,
+        "",
+    ));
+    let p = Vec3::new(0.2, 0.7, 3.4);
+    let want = noise::fbm(Vec3::new(0.2, 0.7, 0.4), 0.6, 3);
+    assert!((t.evaluate(&TextureCoords::new([0.0; 2], p)).r - want).abs() < 1e-12);
+    // Dots: red in them, the plane green.
+    let (t, _) = diffuse(&scene(
+        r#"{ texture = "dots", inside = [1, 0, 0], outside = [0, 1, 0] }"#,
+        "",
+    ));
+    let mut seen = [false; 2];
+    for i in 0..400 {
+        let uv = [i as f64 * 0.37, i as f64 * 0.11];
+        let c = t.evaluate(&TextureCoords::new(uv, Vec3::ZERO));
+        seen[(c == Color::new(1.0, 0.0, 0.0)) as usize] = true;
+        assert!(
+            c == Color::new(1.0, 0.0, 0.0) || c == Color::new(0.0, 1.0, 0.0),
+            "{c:?}"
+        );
+    }
+    assert_eq!(seen, [true, true]);
+    // A sphere with pbrt's (u, v): +x is (0, ½).
+    let (_, l) = diffuse(&scene("[1, 1, 1]", "uv_map = \"pbrt\"\n"));
+    assert_eq!(
+        l.scene.geometry.primitives[0]
+            .shape
+            .uv_at(Vec3::new(1.0, 0.0, 0.0), 0),
+        [0.0, 0.5]
+    );
+    for (diffuse, extra, says) in [
+        (
+            r#"{ texture = "fbm", octaves = 40 }"#,
+            "",
+            "at most 32 octaves",
+        ),
+        (
+            r#"{ texture = "mapped", mapping = "uv", transform = { translate = [1, 0, 0] }, of = [1, 1, 1] }"#,
+            "",
+            "the `uv` mapping takes no `transform`",
+        ),
+        (
+            r#"{ texture = "mapped", mapping = "conical", of = [1, 1, 1] }"#,
+            "",
+            "unknown mapping `conical`",
+        ),
+        (
+            r#"{ texture = "directionmix", textures = [[1, 1, 1]], direction = [0, 1, 0] }"#,
+            "",
+            "expected two textures or colours, found 1",
+        ),
+        ("[1, 1, 1]", "uv_map = \"maya\"\n", "unknown uv_map `maya`"),
+    ] {
+        let e = parse_scene(
+            Path::new("bad.toml"),
+            &scene(diffuse, extra),
+            Path::new("."),
+        )
+        .err()
+        .unwrap_or_else(|| panic!("{diffuse} {extra}: accepted"))
+        .to_string();
+        assert!(e.contains(says) && e.contains("bad.toml:"), "{e}");
+    }
+}

@@ -356,15 +356,7 @@ impl<'s> Reader<'s> {
                     _ => &["texture", "textures", "amount"],
                 };
                 let f = self.src.table(v, "a texture", keys)?;
-                let textures = f.required("textures")?;
-                let list = self.src.array(textures, "two textures or colours")?;
-                let [a, b] = list else {
-                    return Err(self.src.error(
-                        textures.span(),
-                        format!("expected two textures or colours, found {}", list.len()),
-                    ));
-                };
-                let (a, b) = (self.texture(a)?, self.texture(b)?);
+                let [a, b] = self.texture_pair(&f)?;
                 let combined = match kind.0.as_str() {
                     "scale" => Texture::Scale(Arc::new([a, b])),
                     _ => {
@@ -431,19 +423,9 @@ impl<'s> Reader<'s> {
                     "a directionmix texture",
                     &["texture", "textures", "direction"],
                 )?;
-                let textures = f.required("textures")?;
-                let list = self.src.array(textures, "two textures or colours")?;
-                let [a, b] = list else {
-                    return Err(self.src.error(
-                        textures.span(),
-                        format!("expected two textures or colours, found {}", list.len()),
-                    ));
-                };
+                let pair = self.texture_pair(&f)?;
                 let d = f.direction("direction", None)?.normalized();
-                Ok(Texture::DirectionMix(Arc::new((
-                    d,
-                    [self.texture(a)?, self.texture(b)?],
-                ))))
+                Ok(Texture::DirectionMix(Arc::new((d, pair))))
             }
             "mapped" => self.mapped_texture(v),
             other => {
@@ -469,6 +451,19 @@ impl<'s> Reader<'s> {
                 })
             }
         }
+    }
+
+    /// A texture's `textures = [a, b]`: two textures or colours.
+    fn texture_pair(&self, f: &Fields<'_, 's>) -> Result<[Texture; 2]> {
+        let textures = f.required("textures")?;
+        let list = self.src.array(textures, "two textures or colours")?;
+        let [a, b] = list else {
+            return Err(self.src.error(
+                textures.span(),
+                format!("expected two textures or colours, found {}", list.len()),
+            ));
+        };
+        Ok([self.texture(a)?, self.texture(b)?])
     }
 
     /// A texture looked up through a mapping: `{ texture = "mapped", mapping = …, of = T }`,
