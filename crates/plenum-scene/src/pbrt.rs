@@ -2636,7 +2636,7 @@ impl Parser {
                 } else {
                     bytes
                 };
-                let mesh = crate::ply::parse_ply_with(&path, &bytes, false)
+                let mesh = crate::ply::parse_ply_pbrt(&path, &bytes, PBRT_TRIANGLE_UVS)
                     .map_err(|e| self.error(&floc, format!("{}: {}", path.display(), e.message)))?;
                 for key in ["displacement", "edgelength"] {
                     if let Some(q) = p.get(key) {
@@ -2650,7 +2650,7 @@ impl Parser {
                 if reverse {
                     self.warn(loc, "ReverseOrientation on a one-sided PLY light is not supported: it emits as its faces are wound");
                 }
-                Shape::Mesh(Arc::new(mesh.with_corner_uvs(PBRT_TRIANGLE_UVS)))
+                Shape::Mesh(Arc::new(mesh))
             }
             "curve" => {
                 self.warn(loc, "curves are not supported: skipped");

@@ -96,6 +96,72 @@ pub(crate) fn parse_ply_with(
     bytes: &[u8],
     keep_indices: bool,
 ) -> Result<TriangleMesh, SceneError> {
+    let ply = read(path, bytes)?;
+    if keep_indices {
+        TriangleMesh::new_keeping_indices(ply.positions, ply.triangles, ply.normals, ply.uvs)
+    } else {
+        TriangleMesh::new(ply.positions, ply.triangles, ply.normals, ply.uvs)
+    }
+    .map_err(|e| SceneError::file(path, e.to_string()))
+}
+
+/// A PLY mesh as pbrt-v4 reads it: without uvs in the file, each triangle has pbrt's corner
+/// (u, v) (0, 0), (1, 0), (1, 1), and each quad (a bilinear patch in pbrt-v4) the patch's
+/// (0, 0), (1, 0), (1, 1), (0, 1) at its four corners, which its two triangles share.
+pub(crate) fn parse_ply_pbrt(
+    path: &Path,
+    bytes: &[u8],
+    triangle_uvs: [[f64; 2]; 3],
+) -> Result<TriangleMesh, SceneError> {
+    let ply = read(path, bytes)?;
+    let mesh = if !ply.uvs.is_empty() || !ply.halves.iter().any(|&h| h != Half::Whole) {
+        TriangleMesh::new(ply.positions, ply.triangles, ply.normals, ply.uvs)
+            .map(|m| m.with_corner_uvs(triangle_uvs))
+    } else {
+        // Quads' corners have (u, v) of their own: every triangle gets corners of its own.
+        let corners: Vec<u32> = ply.triangles.iter().flatten().copied().collect();
+        let positions = corners.iter().map(|&i| ply.positions[i as usize]).collect();
+        let normals = match ply.normals.is_empty() {
+            true => Vec::new(),
+            false => corners.iter().map(|&i| ply.normals[i as usize]).collect(),
+        };
+        let uvs = ply
+            .halves
+            .iter()
+            .flat_map(|h| match h {
+                Half::Whole => triangle_uvs,
+                Half::First => [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]],
+                Half::Second => [[0.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+            })
+            .collect();
+        let triangles = (0..ply.triangles.len() as u32)
+            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+            .collect();
+        TriangleMesh::new(positions, triangles, normals, uvs)
+    };
+    mesh.map_err(|e| SceneError::file(path, e.to_string()))
+}
+
+/// Which part of its face a triangle is.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Half {
+    /// A triangle of the file, or a piece of a polygon of five or more corners.
+    Whole,
+    /// A quad's (f0, f1, f2) and (f0, f2, f3).
+    First,
+    Second,
+}
+
+/// What a PLY file holds: vertices, faces fanned into triangles.
+struct Ply {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    uvs: Vec<[f64; 2]>,
+    triangles: Vec<[u32; 3]>,
+    halves: Vec<Half>,
+}
+
+fn read(path: &Path, bytes: &[u8]) -> Result<Ply, SceneError> {
     let end = find(bytes, b"end_header")
         .ok_or_else(|| SceneError::file(path, "not a PLY file: no `end_header` line"))?;
     let body_start = bytes[end..]
@@ -199,6 +265,7 @@ pub(crate) fn parse_ply_with(
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
     let mut triangles = Vec::new();
+    let mut halves = Vec::new();
     let mut vertices_seen = None;
     for element in &elements {
         let find = |names: &[&str]| {
@@ -299,6 +366,11 @@ pub(crate) fn parse_ply_with(
                 }
                 for k in 1..face.len() - 1 {
                     triangles.push([face[0] as u32, face[k] as u32, face[k + 1] as u32]);
+                    halves.push(match (face.len(), k) {
+                        (4, 1) => Half::First,
+                        (4, _) => Half::Second,
+                        _ => Half::Whole,
+                    });
                 }
             }
         }
@@ -312,12 +384,13 @@ pub(crate) fn parse_ply_with(
     if uvs.len() != positions.len() {
         uvs.clear();
     }
-    if keep_indices {
-        TriangleMesh::new_keeping_indices(positions, triangles, normals, uvs)
-    } else {
-        TriangleMesh::new(positions, triangles, normals, uvs)
-    }
-    .map_err(|e| SceneError::file(path, e.to_string()))
+    Ok(Ply {
+        positions,
+        normals,
+        uvs,
+        triangles,
+        halves,
+    })
 }
 
 fn find(haystack: &[u8], needle: &[u8]) -> Option<usize> {

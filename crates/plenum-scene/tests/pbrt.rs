@@ -1433,3 +1433,28 @@ fn spectrum_files_are_read_beside_the_scene() {
     let e = error(&scene("metal-Au-etta")).to_string();
     assert!(e.contains("did you mean `metal-Au-eta`"), "{e}");
 }
+
+#[test]
+fn ply_quads_without_uv_have_the_uv_of_pbrts_bilinear_patches() {
+    // pbrt-v4 reads a PLY quad as a bilinear patch with (0, 0), (1, 0), (1, 1), (0, 1) at
+    // its corners in file order, and a triangle with (0, 0), (1, 0), (1, 1). A square quad's
+    // patch is affine: (x, y) has (u, v) = (x, y).
+    use plenum_core::math::{Ray, Vec3};
+    let ply = "ply\nformat ascii 1.0\nelement vertex 7\nproperty float x\nproperty float y\nproperty float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 0\n5 0 0\n5 2 0\n4 0 1 2 3\n3 4 5 6\n";
+    let scene = "WorldBegin\nLightSource \"point\"\nTexture \"t\" \"spectrum\" \"checkerboard\"\nMaterial \"diffuse\" \"texture reflectance\" \"t\"\nShape \"plymesh\" \"string filename\" \"m.ply\"\n";
+    let l = load_files(&[("scene.pbrt", scene.as_bytes()), ("m.ply", ply.as_bytes())])
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    let uv = |x: f64, y: f64| {
+        let ray = Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z);
+        let (prim, hit) = l.scene.geometry.intersect(&ray, f64::INFINITY).unwrap();
+        l.scene.geometry.interaction(&ray, prim, &hit).uv
+    };
+    let near = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-6;
+    for (x, y) in [(0.25, 0.75), (0.8, 0.1), (0.5, 0.5), (0.1, 0.9)] {
+        assert!(near(uv(x, y), [x, y]), "({x}, {y}): {:?}", uv(x, y));
+    }
+    // The triangle (3, 0), (5, 0), (5, 2): (4.5, 0.5) is ¼ of the first corner, ½ of the
+    // second, ¼ of the third: (0.75, 0.25). (The file's coordinates are f32.)
+    assert!(near(uv(4.5, 0.5), [0.75, 0.25]), "{:?}", uv(4.5, 0.5));
+}
