@@ -1892,9 +1892,9 @@ impl Parser {
             }
         };
         // The texture's space: the transformation current where it is defined.
-        let to_texture = Transform::from_matrix(self.ctm())
-            .ok_or_else(|| self.error(loc, "the texture's transformation is singular"))?
-            .inverted();
+        let to_world = Transform::from_matrix(self.ctm())
+            .ok_or_else(|| self.error(loc, "the texture's transformation is singular"))?;
+        let to_texture = to_world.inverted();
         let mapping = |s: &mut Self| -> Result<Mapping> {
             let uv = |s: &mut Self| -> Result<Mapping> {
                 Ok(Mapping::Uv {
@@ -2118,9 +2118,7 @@ impl Parser {
                 })
             }
             "directionmix" => {
-                let d = Transform::from_matrix(self.ctm())
-                    .expect("inverted above")
-                    .vector(self.point(p, "dir", Vec3::Y)?);
+                let d = to_world.vector(self.point(p, "dir", Vec3::Y)?);
                 if !(d.length() > 0.0) || !finite(d) {
                     return Err(self.error(
                         &p.get("dir").map_or(loc.clone(), |q| q.loc.clone()),

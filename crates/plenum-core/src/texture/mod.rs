@@ -49,7 +49,7 @@ pub enum Texture {
     Mapped(Arc<(Mapping, Texture)>),
 }
 
-/// Pbrt-v4's noise textures (section 10.6 of its book), by [`noise`]'s Perlin noise.
+/// pbrt-v4's noise textures (section 10.6 of its book), by [`noise`]'s Perlin noise.
 #[derive(Clone, Debug)]
 pub enum Noise {
     /// Fractional Brownian motion: octaves weighted by omega per octave.

@@ -1,4 +1,4 @@
-//! Pbrt-v4's procedural patterns on Perlin noise: fBm, wrinkled, windy, marble and polka
+//! pbrt-v4's procedural patterns on Perlin noise: fBm, wrinkled, windy, marble and polka
 //! dots (pbrt-v4, section 10.6). Plenum sums every octave (see [`noise::fbm`]).
 
 use super::noise::{self, fbm, turbulence};
