@@ -461,7 +461,14 @@ pub fn camera_sample(
     };
     let mut stream = sampler.stream(settings.seed, x, y, index);
     let f = settings.filter.sample(stream.pixel());
-    let lens = stream.next_2d();
+    // A pinhole reads no lens point: its dimension is passed over, the stream left as
+    // drawing it would, so the image is the same either way.
+    let lens = if camera.is_pinhole() {
+        stream.skip_2d();
+        [0.5; 2]
+    } else {
+        stream.next_2d()
+    };
     let shutter = stream.next_1d();
     let (px, py) = (x as f64 + 0.5 + f.dx, y as f64 + 0.5 + f.dy);
     (camera.sample_ray(px, py, lens, shutter), f.weight, stream)
