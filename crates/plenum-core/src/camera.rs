@@ -129,6 +129,8 @@ pub struct Camera {
     /// How far outside the image (in pixels) light paths still reach it: a pixel filter
     /// wider than a pixel spreads their splats that far in.
     margin: f64,
+    /// Nothing in the scene moves (see [`Camera::with_still_scene`]).
+    still_scene: bool,
 }
 
 impl Camera {
@@ -147,6 +149,7 @@ impl Camera {
             width: width as f64,
             height: height as f64,
             margin: 0.0,
+            still_scene: false,
         }
     }
 
@@ -154,6 +157,19 @@ impl Camera {
     pub fn with_margin(mut self, margin: f64) -> Camera {
         self.margin = margin;
         self
+    }
+
+    /// The camera of a scene in which no object moves (`still`): whether the camera
+    /// itself moves decides then whether rays' times matter ([`Camera::is_still`]).
+    pub fn with_still_scene(mut self, still: bool) -> Camera {
+        self.still_scene = still;
+        self
+    }
+
+    /// Neither the camera nor (as [`Camera::with_still_scene`] said) anything else moves:
+    /// every ray sees the same scene at any time, so a sample's time need not be drawn.
+    pub fn is_still(&self) -> bool {
+        self.still_scene && self.settings.motion.is_none()
     }
 
     /// The ray through raster position (x, y) from the lens centre at time 0: (0, 0) is the

@@ -87,8 +87,9 @@ pub fn render_film(
         SplatBuffer::new(0, 0, 0.0)
     };
     splats.preload(&film.splats);
-    let camera =
-        Camera::new(&scene.camera, settings.width, settings.height).with_margin(splats.margin());
+    let camera = Camera::new(&scene.camera, settings.width, settings.height)
+        .with_margin(splats.margin())
+        .with_still_scene(!scene.geometry.moves());
     let strategies = settings.integrator.writes_strategies().then(|| {
         StrategyImages::new(
             settings.width,
@@ -469,7 +470,13 @@ pub fn camera_sample(
     } else {
         stream.next_2d()
     };
-    let shutter = stream.next_1d();
+    // Where nothing moves, no ray's time matters: the same for the shutter's dimension.
+    let shutter = if camera.is_still() {
+        stream.skip_1d();
+        0.0
+    } else {
+        stream.next_1d()
+    };
     let (px, py) = (x as f64 + 0.5 + f.dx, y as f64 + 0.5 + f.dy);
     (camera.sample_ray(px, py, lens, shutter), f.weight, stream)
 }

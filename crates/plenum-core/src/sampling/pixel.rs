@@ -225,12 +225,22 @@ impl SampleStream {
     /// reads, such as a pinhole camera's lens point, whose permutation and hashes cost a
     /// cheap camera ray a tenth of its time.
     pub fn skip_2d(&mut self) {
+        self.skip(2);
+    }
+
+    /// [`skip_2d`](Self::skip_2d) for a 1-D value (a still scene's shutter time).
+    pub fn skip_1d(&mut self) {
+        self.skip(1);
+    }
+
+    /// Passes over a value of `lanes` dimensions' random numbers.
+    fn skip(&mut self, lanes: u32) {
         self.dimension = self.dimension.max(1);
         let d = self.dimension;
         self.dimension += 1;
         let draws = match self.sampler {
             PixelSampler::Sobol { .. } if d < STRATIFIED_DIMENSIONS => 0,
-            _ => 2,
+            _ => lanes,
         };
         for _ in 0..draws {
             self.rng.next_u32();
@@ -332,10 +342,10 @@ mod tests {
             .collect()
     }
 
-    /// After `skip_2d` every later value is the one it is after `next_2d`, for every
-    /// sampler, in the stratified dimensions and past them.
+    /// After `skip_2d` (`skip_1d`) every later value is the one it is after `next_2d`
+    /// (`next_1d`), for every sampler, in the stratified dimensions and past them.
     #[test]
-    fn skipping_a_2d_value_leaves_the_stream_as_drawing_it_does() {
+    fn skipping_a_value_leaves_the_stream_as_drawing_it_does() {
         let samplers = [
             PixelSampler::Grid { n: 4 },
             PixelSampler::Random { spp: 16 },
@@ -353,6 +363,8 @@ mod tests {
                     }
                     a.next_2d();
                     b.skip_2d();
+                    a.next_1d();
+                    b.skip_1d();
                     for _ in 0..4 {
                         assert_eq!(a.next_1d(), b.next_1d(), "{s:?} {index} {before}");
                         assert_eq!(a.next_2d(), b.next_2d(), "{s:?} {index} {before}");

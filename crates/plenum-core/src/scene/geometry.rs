@@ -147,6 +147,11 @@ impl Geometry {
         self
     }
 
+    /// Whether some primitive moves while the shutter is open.
+    pub fn moves(&self) -> bool {
+        self.primitives.iter().any(|p| p.motion.is_some())
+    }
+
     /// Which structure holds the primitives (and the triangles of every mesh).
     pub fn accel_kind(&self) -> AccelKind {
         self.accel.kind()

@@ -92,13 +92,20 @@ impl TextureCoords {
     }
 }
 
+/// Whether the whole number `s` is even, as `s.rem_euclid(2.0) == 0.0` says (infinite and
+/// NaN: no) without its library call: halving, flooring and doubling are exact.
+#[inline]
+fn is_even(s: f64) -> bool {
+    s - 2.0 * (0.5 * s).floor() == 0.0
+}
+
 impl Texture {
     pub fn evaluate(&self, at: &TextureCoords) -> Color {
         match self {
             Texture::Constant(c) => *c,
             Texture::Checker2d { even, odd, scale } => {
                 let s = (at.uv[0] * scale).floor() + (at.uv[1] * scale).floor();
-                if s.rem_euclid(2.0) == 0.0 {
+                if is_even(s) {
                     *even
                 } else {
                     *odd
@@ -107,7 +114,7 @@ impl Texture {
             Texture::Checker3d { even, odd, scale } => {
                 let p = at.object_point * *scale;
                 let s = p.x.floor() + p.y.floor() + p.z.floor();
-                if s.rem_euclid(2.0) == 0.0 {
+                if is_even(s) {
                     *even
                 } else {
                     *odd
@@ -365,6 +372,24 @@ impl ImageTexture {
 
 #[cfg(test)]
 mod tests {
+    /// The checkers' parity against the library's remainder: signs, infinities, NaN, and
+    /// odd numbers up to where f64 has no odd integers left.
+    #[test]
+    fn evenness_is_the_remainder_of_two() {
+        let mut cases = vec![
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            9.007_199_254_740_992e15,
+            -1e300,
+        ];
+        cases.extend((-6..=6).map(f64::from));
+        cases.extend((0..64).map(|k| 2f64.powi(k) + 1.0));
+        for s in cases {
+            assert_eq!(super::is_even(s), s.rem_euclid(2.0) == 0.0, "{s}");
+        }
+    }
+
     use super::*;
 
     fn at(u: f64, v: f64) -> TextureCoords {
