@@ -73,13 +73,25 @@ impl PixelSums {
     }
 
     pub fn add(&mut self, c: Color, weight: f64) {
-        for (i, v) in [c.r, c.g, c.b].into_iter().enumerate() {
-            let wl = v * weight;
-            self.weighted[i] += units(wl);
-            self.plain[i] += units(v);
-            self.weighted_squared[i] += wl * wl;
+        if weight == 1.0 {
+            // A box filter's sample (and any sample of weight 1): w·L is L, so one
+            // conversion serves both sums, with the integers the general case gives.
+            for (i, v) in [c.r, c.g, c.b].into_iter().enumerate() {
+                let u = units(v);
+                self.weighted[i] += u;
+                self.plain[i] += u;
+                self.weighted_squared[i] += v * v;
+            }
+            self.weight += 1 << 32;
+        } else {
+            for (i, v) in [c.r, c.g, c.b].into_iter().enumerate() {
+                let wl = v * weight;
+                self.weighted[i] += units(wl);
+                self.plain[i] += units(v);
+                self.weighted_squared[i] += wl * wl;
+            }
+            self.weight += units(weight);
         }
-        self.weight += units(weight);
         self.count += 1;
         let y = c.luminance();
         self.luminance += y;
@@ -402,6 +414,36 @@ const SPPM_UNSPLIT: &str = "SPPM renders cannot be merged: each iteration gather
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A sample of weight 1 sums to the integers of the general case (weight 1 + 2⁻⁵², one
+    /// ulp off, takes it; its weight's units round to 2³² too).
+    #[test]
+    fn a_sample_of_weight_one_sums_as_any_weight_does() {
+        let colors = [
+            Color::new(0.25, 1.0 / 3.0, 7.5),
+            Color::new(0.0, 1e-12, 123456.789),
+            Color::new(3e9, 0.1, 0.7),
+        ];
+        let (mut one, mut general) = (PixelSums::default(), PixelSums::default());
+        for c in colors {
+            one.add(c, 1.0);
+            // The general case, by hand, at weight exactly 1.
+            for (i, v) in [c.r, c.g, c.b].into_iter().enumerate() {
+                general.weighted[i] += units(v * 1.0);
+                general.plain[i] += units(v);
+                general.weighted_squared[i] += (v * 1.0) * (v * 1.0);
+            }
+            general.weight += units(1.0);
+            general.count += 1;
+            let y = c.luminance();
+            general.luminance += y;
+            general.luminance_squared += y * y;
+        }
+        assert_eq!(one, general);
+        let mut near = PixelSums::default();
+        near.add(colors[0], 1.0 + f64::EPSILON);
+        assert_eq!(near.weight, one.weight / 3);
+    }
 
     /// The i64 shortcut gives the integer the i128 conversion gives, on both sides of
     /// where it stops applying, and saturates and maps NaN as before.
