@@ -212,6 +212,10 @@ diffuse = 0.5
 diffuse = 0
 transmissive = [0.2, 0.8, 0.2]
 ior = 1.5
+[materials.textured_glass]
+diffuse = 0
+transmissive = { texture = "checker3d", even = [0.2, 0.8, 0.2], odd = [0.2, 0.8, 0.2] }
+ior = 1.5
 [materials.opaque]
 diffuse = 0.5
 [[lights]]
@@ -225,6 +229,8 @@ material = "floor"
 
 /// The floor point under the centre pixel sees the light through green glass: its colour is
 /// k_d · cos θ · k_t. An opaque ball there gives a black shadow; two glass balls, k_t².
+/// k_t is read from the material where it is uniform and looked up at the hit where it is
+/// a texture: both give the same colour.
 #[test]
 fn shadows_through_glass_are_coloured_by_k_t() {
     let cos = 0.5f64.sqrt();
@@ -245,6 +251,15 @@ fn shadows_through_glass_are_coloured_by_k_t() {
         close(glass, Color::new(0.2, 0.8, 0.2) * (0.5 * cos), 1e-6),
         "{glass:?}"
     );
+    let textured = draw(
+        &scene(&format!(
+            "{SHADOW_SCENE}{}",
+            ball("[8, 5, 0]", "textured_glass")
+        )),
+        1,
+    )
+    .get(4, 4);
+    assert_eq!(textured, glass);
     let two = format!(
         "{SHADOW_SCENE}{}{}",
         ball("[8, 5, 0]", "green_glass"),

@@ -387,8 +387,7 @@ impl<'a> Whitted<'a> {
                     occluders.push((hit.t, prim));
                 }
                 if self.scene.geometry.is_transmissive(prim) {
-                    let occ = self.scene.geometry.interaction(&ray, prim, hit);
-                    s *= self.scene.coefficients(&occ).transmissive;
+                    s *= self.scene.transmissive(&ray, prim, hit);
                 } else {
                     s = Color::BLACK;
                 }

@@ -23,7 +23,7 @@ pub use physical::{
 
 use crate::bxdf::{Bxdf, PhongBxdf};
 use crate::color::Color;
-use crate::texture::TextureCoords;
+use crate::texture::{Texture, TextureCoords};
 use plenum_spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// Index of a material in a scene's table (`Scene::materials`).
@@ -220,6 +220,23 @@ impl Material {
                 ..base
             },
             Material::Mix { .. } => base,
+        }
+    }
+
+    /// The k_t of [`coefficients`](Self::coefficients) where it is the same at every point
+    /// (what a shadow ray keeps passing through), so that no hit need be worked out for it;
+    /// `None` where it varies or the scene blends it (a mix).
+    pub fn uniform_transmissive(&self) -> Option<Color> {
+        match self {
+            Material::Phong(m) => match m.transmissive {
+                Texture::Constant(c) => Some(c),
+                _ => None,
+            },
+            Material::Diffuse(_) | Material::Conductor(_) | Material::CoatedDiffuse(_) => {
+                Some(Color::BLACK)
+            }
+            Material::Dielectric(_) | Material::ThinDielectric(_) => Some(Color::WHITE),
+            Material::DiffuseTransmission(_) | Material::Mix { .. } => None,
         }
     }
 

@@ -23,10 +23,10 @@ use crate::accel::AccelKind;
 use crate::bxdf::{Bsdf, Bxdf};
 use crate::camera::CameraSettings;
 use crate::color::Color;
-use crate::geometry::Shape;
+use crate::geometry::{HitRecord, Shape};
 use crate::light_sampler::LightSamplerKind;
 use crate::material::{rgb_radiance, Coefficients, Material, PhongMaterial, Scattering};
-use crate::math::Vec3;
+use crate::math::{Ray, Vec3};
 use plenum_spectrum::{SampledSpectrum, SampledWavelengths};
 
 #[derive(Clone, Debug)]
@@ -79,6 +79,20 @@ impl Scene {
             return Coefficients::blend(&parts);
         }
         self.materials.coefficients(p.material, &it.texture())
+    }
+
+    /// The k_t of `primitive` at `hit` along `ray`: what light a shadow ray keeps passing
+    /// through it. Read from the material where it is uniform, without working out the hit's
+    /// surface (most of the cost of a shadow ray through glass).
+    pub fn transmissive(&self, ray: &Ray, primitive: u32, hit: &HitRecord) -> Color {
+        let p = &self.geometry.primitives[primitive as usize];
+        if p.vertex_materials.is_none() {
+            if let Some(t) = self.materials[p.material as usize].uniform_transmissive() {
+                return t;
+            }
+        }
+        let it = self.geometry.interaction(ray, primitive, hit);
+        self.coefficients(&it).transmissive
     }
 
     /// The emission k_e of a Phong material at a hit on a primitive that is not a light's
