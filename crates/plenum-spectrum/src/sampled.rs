@@ -246,7 +246,7 @@ impl SampledWavelengths {
                 up -= 1.0;
             }
             let x = VISIBLE_X0 - VISIBLE_DX * up;
-            lambda[i] = 538.0 - VISIBLE_WIDTH * x.atanh();
+            lambda[i] = 538.0 - VISIBLE_WIDTH * atanh(x);
             // The density of λ is du/dλ = (1 − x²) / (width · dx): the cosh² of
             // `visible_pdf` without an exponential (the two agree to 2e-7, pbrt-v4's
             // constants being rounded).
@@ -318,7 +318,15 @@ pub fn visible_pdf(lambda: f64) -> f64 {
 /// Inverts the cumulative distribution of [`visible_pdf`]: u in [0, 1) to a wavelength in nm,
 /// λ = 538 − 138.888889 · atanh(0.85691062 − 1.82750197 u).
 pub fn sample_visible_wavelength(u: f64) -> f64 {
-    538.0 - VISIBLE_WIDTH * (VISIBLE_X0 - VISIBLE_DX * u).atanh()
+    538.0 - VISIBLE_WIDTH * atanh(VISIBLE_X0 - VISIBLE_DX * u)
+}
+
+/// atanh x = ½ ln((1 + x)/(1 − x)) for the |x| < 0.975 of the visible map: one `ln`, half
+/// the cost of the library's `atanh` (a `log1p`), within 4e-15 of it there (tested): 6e-13 nm
+/// in λ.
+#[inline]
+fn atanh(x: f64) -> f64 {
+    0.5 * ((1.0 + x) / (1.0 - x)).ln()
 }
 
 /// The constants of [`sample_visible_wavelength`] (pbrt-v4's).
@@ -336,6 +344,19 @@ mod tests {
             let v = sample_visible_wavelength(u);
             assert!((v - l).abs() < 1e-3, "u {u}: {v}");
         }
+    }
+
+    /// Over the visible map's range of x (0.857 down to −0.971), within 4e-15 absolutely
+    /// (measured 3.6e-15).
+    #[test]
+    fn atanh_by_one_log_matches_the_library() {
+        let mut worst = 0.0f64;
+        for k in 0..=100_000 {
+            let u = k as f64 / 100_000.0;
+            let x = VISIBLE_X0 - VISIBLE_DX * u;
+            worst = worst.max((atanh(x) - x.atanh()).abs());
+        }
+        assert!(worst < 4e-15, "{worst:e}");
     }
 
     #[test]

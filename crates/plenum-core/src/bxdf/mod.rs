@@ -314,6 +314,8 @@ impl Bxdf {
 pub struct Bsdf {
     frame: Frame,
     bxdf: Bxdf,
+    /// `bxdf.flags()`, asked several times per vertex.
+    flags: BxdfFlags,
 }
 
 impl Bsdf {
@@ -336,7 +338,15 @@ impl Bsdf {
             }
             None => Frame::from_z(n),
         };
-        Bsdf { frame, bxdf }
+        Bsdf::placed(frame, bxdf)
+    }
+
+    fn placed(frame: Frame, bxdf: Bxdf) -> Bsdf {
+        Bsdf {
+            frame,
+            flags: bxdf.flags(),
+            bxdf,
+        }
     }
 
     pub fn bxdf(&self) -> &Bxdf {
@@ -352,14 +362,14 @@ impl Bsdf {
     }
 
     pub fn flags(&self) -> BxdfFlags {
-        self.bxdf.flags()
+        self.flags
     }
 
     /// [`Bxdf::split_diffuse`], each part in this BSDF's frame.
     pub fn split_diffuse(&self) -> (Option<Bsdf>, Option<Bsdf>) {
         let (diffuse, rest) = self.bxdf.split_diffuse();
         let frame = self.frame;
-        let place = |bxdf| Bsdf { frame, bxdf };
+        let place = |bxdf| Bsdf::placed(frame, bxdf);
         (diffuse.map(place), rest.map(place))
     }
 
